@@ -1,0 +1,65 @@
+#include "bake/bake_output.h"
+
+#include <cstdio>
+
+#include "io/image_io.h"
+
+namespace bb {
+
+std::string lightmapFileName(int page, const char* extension) {
+    char name[64];
+    std::snprintf(name, sizeof name, "lightmap_%d.%s", page, extension);
+    return name;
+}
+
+Status writeBakeOutputs(const std::string& outDir, const Scene& scene, const Layout& layout, Baker& baker,
+                        const BakeOutputInfo& info) {
+    if (Status s = io::ensureDirectory(outDir); !s) return s;
+    LightmapPages maps = baker.readLightmaps();
+    const std::string units = "L_lm = E/pi (irradiance over pi), scene radiance units; row 0 = v 0 (glTF: v down from the top)";
+    nlohmann::json pages = nlohmann::json::array();
+    for (size_t p = 0; p < maps.pages.size(); ++p) {
+        std::string exr = lightmapFileName(int(p));
+        if (Status s = io::writeExrHalf(outDir + "/" + exr, maps.pages[p], {{"bundlebake:units", units}}); !s) return s;
+        nlohmann::json page = {{"page", p}, {"exr", exr}};
+        if (info.writePreviews) {
+            std::string png = lightmapFileName(int(p), "png");
+            if (Status s = io::writePngToneMapped(outDir + "/" + png, maps.pages[p]); !s) return s;
+            page["preview_png"] = png;
+        }
+        pages.push_back(page);
+    }
+    nlohmann::json instances = nlohmann::json::array();
+    for (size_t i = 0; i < scene.instances.size(); ++i) {
+        const auto& r = layout.rects[i];
+        instances.push_back({{"name", scene.instances[i].name}, {"node", scene.instances[i].node},
+                             {"mesh", scene.instances[i].mesh}, {"page", r.page},
+                             {"rect_texels", {r.x, r.y, r.width, r.height}},
+                             {"uv1_scale", {r.scale.x, r.scale.y}}, {"uv1_offset", {r.offset.x, r.offset.y}},
+                             {"texel_density", r.texelDensity}});
+    }
+    nlohmann::json manifest = {
+        {"generator", "bundlebake"},
+        {"scene", scene.path},
+        {"units", units},
+        {"mapping", "page_uv = TEXCOORD_1 * uv1_scale + uv1_offset"},
+        {"layout", layout.mode == UvLayout::Asset ? "asset" : "pack"},
+        {"resolution", layout.resolution},
+        {"padding_texels", layout.padding},
+        {"texel_density", layout.texelDensity},
+        {"pages", pages},
+        {"instances", instances},
+    };
+    if (Status s = io::writeJson(outDir + "/manifest.json", manifest); !s) return s;
+
+    nlohmann::json stats = baker.stats().toJson();
+    stats["backend"] = info.backend;
+    stats["renderer"] = info.renderer;
+    stats["settings"] = info.settings;
+    stats["wall_seconds"] = info.wallSeconds;
+    stats["scene"] = {{"path", scene.path}, {"triangles", baker.mesh().triangleCount()},
+                      {"instances", scene.instances.size()}, {"lights", scene.lights.size()}};
+    return io::writeJson(outDir + "/stats.json", stats);
+}
+
+}  // namespace bb

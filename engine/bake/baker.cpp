@@ -1,0 +1,698 @@
+#include "bake/baker.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <cmath>
+#include <numeric>
+
+#include "bake/directions.h"
+#include "core/check.h"
+#include "core/log.h"
+#include "core/memory.h"
+#include "gl/gl.h"
+#include "gl/objects.h"
+#include "gl/shader.h"
+#include "glsl/shared/bundle_layout.h"
+
+namespace bb {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// A rectangle of the bundle plane, in pixels of the direction's full grid.
+struct TileRect {
+    int x = 0, y = 0, width = 0, height = 0;
+};
+
+
+}  // namespace
+
+struct Baker::Impl {
+    BakeOptions options;
+    BakeMesh mesh;
+    Layout layout;
+    std::vector<Material> materials;
+    std::vector<DirectionalLight> lights;
+    BakeStats stats;
+    std::vector<glm::vec3> directions;
+
+    // scene frame
+    glm::vec3 sphereCenter{0.0f};
+    float sphereRadius = 1.0f;
+    float pixelSize = 1.0f;
+    int gridSize = 1;         // pixels across the full bundle
+    int maxTileSize = 2048;   // head image side
+    float depthBias = 0.0f;
+    double historyPower = 0.0;
+    double accumScale = 1.0;  // stored sums are true sums / accumScale
+    std::vector<double> projectedArea;  // per triangle world area (for prediction)
+    std::vector<glm::vec3> triangleNormal;
+
+    // GL objects
+    gl::Buffer vertexBuffer, triangleBuffer, metaIndexBuffer, nodeBuffer, counterBuffer;
+    gl::VertexArray vao;
+    gl::Texture albedoMap, emissionMap, accum, sunMap, radiance, scratch, heads, envTexture;
+    gl::Framebuffer bundleFbo, pageFbo, metaFbo;
+    gl::Program appendProgram, updateProgram, sunProgram, resolveProgram, dilateProgram, rescaleProgram, metaProgram;
+    std::vector<gl::Texture> materialTextures;
+    int64_t nodeCapacity = 0;
+
+    Status init(const Scene& scene);
+    Status buildPrograms();
+    void uploadMesh();
+    void metaPass(const Scene& scene);
+    void bakeSun();
+    void bakeDirection(int index);
+    // Draws the bundle of direction d over the given tiles (splitting on
+    // overflow) and runs `update` for each tile that fits.
+    template <class UpdateFn>
+    void traceBundle(const glm::vec3& d, glm::vec2 jitter, uint32_t seed, UpdateFn update, bool recordStats);
+    void setFrameUniforms(GLuint program, const glm::vec3& d, const glm::vec3& u, const glm::vec3& v,
+                          glm::vec2 origin, const TileRect& tile);
+    void resolveInto(bool radianceOut, gl::Texture& target);
+    gl::Texture* dilate(gl::Texture& first, gl::Texture& second, int passes);
+    void dispatchPages(GLuint program);
+    double predictNodes(const glm::vec3& d) const;
+};
+
+nlohmann::json BakeStats::toJson() const {
+    nlohmann::json j;
+    j["directions"] = {{"done", directionsDone}, {"total", directionsTotal}};
+    j["bundle"] = {{"resolution_pixels", bundleResolution}, {"pixel_size_scene_units", pixelSize},
+                   {"history_power", historyPower}};
+    auto sorted = predictedOverActual;
+    std::sort(sorted.begin(), sorted.end());
+    auto pct = [&](double q) { return sorted.empty() ? 0.0 : sorted[size_t(q * (sorted.size() - 1))]; };
+    int maxTiles = tilesPerDirection.empty() ? 0 : *std::max_element(tilesPerDirection.begin(), tilesPerDirection.end());
+    double meanTiles = tilesPerDirection.empty() ? 0.0
+        : std::accumulate(tilesPerDirection.begin(), tilesPerDirection.end(), 0.0) / tilesPerDirection.size();
+    j["tiles"] = {{"drawn", tilesDrawn}, {"per_direction_mean", meanTiles}, {"per_direction_max", maxTiles},
+                  {"overflows_redrawn", overflows},
+                  {"predicted_over_actual_nodes", {{"min", pct(0)}, {"p10", pct(0.1)}, {"median", pct(0.5)},
+                                                   {"p90", pct(0.9)}, {"max", pct(1)}, {"count", sorted.size()}}}};
+    j["memory"] = {{"node_capacity", nodeCapacity}, {"peak_nodes_per_tile", peakNodesPerTile},
+                   {"node_buffer_bytes", nodeBufferBytes}, {"head_image_bytes", headImageBytes},
+                   {"peak_gpu_bytes", peakGpuBytes}, {"bytes_per_node", 12}, {"bytes_per_lightmap_texel", 8}};
+    j["lightmap"] = {{"texels", lightmapTexels}, {"covered_texels", coveredTexels}};
+    double bundleSeconds = secondsBundle > 0 ? secondsBundle : 1e-9;
+    double updateSeconds = secondsUpdate > 0 ? secondsUpdate : 1e-9;
+    j["throughput"] = {{"fragments", fragments}, {"fragments_per_second_bundle_pass", fragments / bundleSeconds},
+                       {"texel_samples", updatedTexels}, {"texel_samples_per_second_update_pass", updatedTexels / updateSeconds}};
+    j["seconds"] = {{"setup", secondsSetup}, {"sun", secondsSun}, {"bundle", secondsBundle}, {"update", secondsUpdate},
+                    {"resolve", secondsResolve}, {"total", secondsTotal()}};
+    return j;
+}
+
+Status Baker::Impl::buildPrograms() {
+    std::string rounding = options.rounding == Rounding::Nearest ? "#define ROUNDING_NEAREST 1\n" : "";
+    struct Spec {
+        gl::Program* target;
+        std::vector<std::string> files;
+        std::string defines;
+    } specs[] = {
+        {&appendProgram, {"bundle/append.vert", "bundle/append.frag"}, rounding},
+        {&updateProgram, {"lightmap/update.vert", "lightmap/update.frag"}, rounding},
+        {&sunProgram, {"lightmap/update.vert", "lightmap/update.frag"}, "#define SUN_PASS 1\n"},
+        {&resolveProgram, {"lightmap/resolve.comp"}, ""},
+        {&dilateProgram, {"lightmap/dilate.comp"}, ""},
+        {&rescaleProgram, {"lightmap/rescale.comp"}, rounding},
+        {&metaProgram, {"lightmap/meta.vert", "lightmap/meta.frag"}, ""},
+    };
+    for (auto& s : specs) {
+        auto p = gl::buildProgram(s.files, s.defines);
+        if (!p) return p.status();
+        *s.target = std::move(p.value());
+    }
+    return Status::ok();
+}
+
+void Baker::Impl::uploadMesh() {
+    vertexBuffer = gl::Buffer::create("bake vertices", int64_t(mesh.vertices.size() * sizeof(BakeVertex)),
+                                      mesh.vertices.data(), 0);
+    triangleBuffer = gl::Buffer::create("bake triangles", int64_t(mesh.triangles.size() * sizeof(BakeTriangle)),
+                                        mesh.triangles.data(), 0);
+    vao = gl::VertexArray::create("bake vertex array");
+    glVertexArrayVertexBuffer(vao.id(), 0, vertexBuffer.id(), 0, sizeof(BakeVertex));
+    const GLuint sizes[] = {4, 4, 2, 2};
+    const GLuint offsets[] = {offsetof(BakeVertex, position), offsetof(BakeVertex, normal), offsetof(BakeVertex, uv0),
+                              offsetof(BakeVertex, lightmapUv)};
+    for (GLuint a = 0; a < 4; ++a) {
+        glEnableVertexArrayAttrib(vao.id(), a);
+        glVertexArrayAttribFormat(vao.id(), a, sizes[a], GL_FLOAT, GL_FALSE, offsets[a]);
+        glVertexArrayAttribBinding(vao.id(), a, 0);
+    }
+}
+
+void Baker::Impl::dispatchPages(GLuint program) {
+    glUniform1i(glGetUniformLocation(program, "pageCount"), layout.pageCount);
+    glUniform2i(glGetUniformLocation(program, "pageSize"), layout.resolution, layout.resolution);
+    glDispatchCompute((layout.resolution + 7) / 8, (layout.resolution + 7) / 8, layout.pageCount);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+}
+
+void Baker::Impl::metaPass(const Scene& scene) {
+    gl::DebugGroup group("meta pass");
+    // upload material textures (linear RGBA float, mipmapped)
+    for (size_t i = 0; i < scene.textures.size(); ++i) {
+        const Texture& t = scene.textures[i];
+        int levels = 1 + int(std::floor(std::log2(std::max(t.width, t.height))));
+        gl::Texture tex = gl::Texture::create2DLevels("material texture " + t.name, GL_RGBA16F, t.width, t.height, levels);
+        // glTF images have row 0 at the top and v = 0 at the top: uploading rows in order makes v = texture t.
+        glTextureSubImage2D(tex.id(), 0, 0, 0, t.width, t.height, GL_RGBA, GL_FLOAT, t.texels.data());
+        glGenerateTextureMipmap(tex.id());
+        glTextureParameteri(tex.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+        glTextureParameteri(tex.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTextureParameteri(tex.id(), GL_TEXTURE_WRAP_S, GL_REPEAT);
+        glTextureParameteri(tex.id(), GL_TEXTURE_WRAP_T, GL_REPEAT);
+        materialTextures.push_back(std::move(tex));
+    }
+    // triangles of each page sorted by material: one draw per (page, material) run
+    std::vector<uint32_t> order(mesh.triangles.size());
+    std::iota(order.begin(), order.end(), 0u);
+    std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+        const auto& ta = mesh.triangles[a];
+        const auto& tb = mesh.triangles[b];
+        return ta.page != tb.page ? ta.page < tb.page : ta.material < tb.material;
+    });
+    std::vector<uint32_t> indices;
+    indices.reserve(order.size() * 3);
+    for (uint32_t t : order)
+        for (uint32_t k = 0; k < 3; ++k) indices.push_back(t * 3 + k);
+    metaIndexBuffer = gl::Buffer::create("meta indices", int64_t(indices.size() * 4), indices.data(), 0);
+    glVertexArrayElementBuffer(vao.id(), metaIndexBuffer.id());
+
+    metaFbo = gl::Framebuffer::create("meta framebuffer");
+    glUseProgram(metaProgram.id());
+    glBindVertexArray(vao.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, triangleBuffer.id());
+    glViewport(0, 0, layout.resolution, layout.resolution);
+    const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    const float zero[4] = {0, 0, 0, 0};
+    size_t run = 0;
+    for (int page = 0; page < layout.pageCount; ++page) {
+        glNamedFramebufferTextureLayer(metaFbo.id(), GL_COLOR_ATTACHMENT0, albedoMap.id(), 0, page);
+        glNamedFramebufferTextureLayer(metaFbo.id(), GL_COLOR_ATTACHMENT1, emissionMap.id(), 0, page);
+        glNamedFramebufferDrawBuffers(metaFbo.id(), 2, buffers);
+        CHECK_EQ(glCheckNamedFramebufferStatus(metaFbo.id(), GL_FRAMEBUFFER), GLenum(GL_FRAMEBUFFER_COMPLETE));
+        glBindFramebuffer(GL_FRAMEBUFFER, metaFbo.id());
+        glClearBufferfv(GL_COLOR, 0, zero);
+        glClearBufferfv(GL_COLOR, 1, zero);
+        while (run < order.size() && mesh.triangles[order[run]].page == uint32_t(page)) {
+            size_t end = run;
+            uint32_t m = mesh.triangles[order[run]].material;
+            while (end < order.size() && mesh.triangles[order[end]].page == uint32_t(page) &&
+                   mesh.triangles[order[end]].material == m)
+                ++end;
+            const Material& mat = materials[m];
+            glUniform3fv(metaProgram.uniform("albedo"), 1, &mat.albedo.x);
+            glUniform3fv(metaProgram.uniform("emission"), 1, &mat.emission.x);
+            glUniform1i(metaProgram.uniform("hasAlbedoTexture"), mat.albedoTexture >= 0);
+            glUniform1i(metaProgram.uniform("hasEmissionTexture"), mat.emissionTexture >= 0);
+            if (mat.albedoTexture >= 0) glBindTextureUnit(2, materialTextures[mat.albedoTexture].id());
+            if (mat.emissionTexture >= 0) glBindTextureUnit(3, materialTextures[mat.emissionTexture].id());
+            glDrawElements(GL_TRIANGLES, GLsizei((end - run) * 3), GL_UNSIGNED_INT,
+                           reinterpret_cast<const void*>(run * 3 * sizeof(uint32_t)));
+            run = end;
+        }
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glMemoryBarrier(GL_ALL_BARRIER_BITS);
+}
+
+Status Baker::Impl::init(const Scene& scene) {
+    auto t0 = Clock::now();
+    materials = scene.materials;
+    lights = scene.lights;
+    stats.directionsTotal = options.directions;
+    if (options.directions < 1) return Status::error("--directions must be at least 1");
+    if (mesh.triangles.empty()) return Status::error("nothing to bake: the scene has no triangles");
+
+    GLint maxTex = 0, maxLayers = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &maxTex);
+    glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &maxLayers);
+    if (layout.resolution > maxTex)
+        return Status::error("--resolution " + std::to_string(layout.resolution) + " exceeds GL_MAX_TEXTURE_SIZE " +
+                             std::to_string(maxTex));
+    if (layout.pageCount > maxLayers)
+        return Status::error(std::to_string(layout.pageCount) + " light map pages exceed GL_MAX_ARRAY_TEXTURE_LAYERS " +
+                             std::to_string(maxLayers) + "; raise --resolution or lower --texel-density");
+
+    // scene frame: bounding sphere of the bounds box
+    sphereCenter = mesh.bounds.center();
+    sphereRadius = std::max(0.5f * glm::length(mesh.bounds.size()), 1e-6f) * 1.001f;
+    depthBias = 4e-6f * (glm::length(sphereCenter) + sphereRadius);
+
+    // bundle pixel from the light map's texel density: sqrt(texel area / world area)
+    double worldArea = 0, texelArea = 0;
+    triangleNormal.resize(mesh.triangles.size());
+    projectedArea.resize(mesh.triangles.size());
+    const double r = layout.resolution;
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+        const auto& a = mesh.vertices[3 * t];
+        const auto& b = mesh.vertices[3 * t + 1];
+        const auto& c = mesh.vertices[3 * t + 2];
+        glm::vec3 n = glm::cross(glm::vec3(b.position - a.position), glm::vec3(c.position - a.position));
+        double area = 0.5 * glm::length(n);
+        projectedArea[t] = area;
+        triangleNormal[t] = glm::length(n) > 0 ? glm::normalize(n) : glm::vec3(0);
+        worldArea += area;
+        glm::vec2 e1 = (b.lightmapUv - a.lightmapUv) * float(r), e2 = (c.lightmapUv - a.lightmapUv) * float(r);
+        texelArea += 0.5 * std::abs(double(e1.x) * e2.y - double(e1.y) * e2.x);
+    }
+    double density = worldArea > 0 && texelArea > 0 ? std::sqrt(texelArea / worldArea) : 1.0 / sphereRadius;
+    if (options.bundleResolution > 0) {
+        gridSize = options.bundleResolution;
+        pixelSize = 2.0f * sphereRadius / float(gridSize);
+    } else {
+        pixelSize = float(0.5 / density);
+        gridSize = std::max(1, int(std::ceil(2.0 * sphereRadius / pixelSize)));
+        pixelSize = 2.0f * sphereRadius / float(gridSize);
+    }
+    stats.bundleResolution = gridSize;
+    stats.pixelSize = pixelSize;
+
+    // tile limits: head image side and node capacity from the budget and GL limits
+    GLint vp[2] = {0, 0};
+    glGetIntegerv(GL_MAX_VIEWPORT_DIMS, vp);
+    maxTileSize = std::min({maxTex, vp[0], vp[1], 2048});
+    while (maxTileSize > 64 && int64_t(maxTileSize) * maxTileSize * 4 > options.memoryBudget / 4) maxTileSize /= 2;
+    int64_t headBytes = int64_t(maxTileSize) * maxTileSize * 4;
+    GLint64 maxSsbo = 0;
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxSsbo);
+    nodeCapacity = std::min<int64_t>((options.memoryBudget - headBytes) / 12, maxSsbo / 12);
+    if (nodeCapacity < 1024)
+        return Status::error("--memory-budget is too small: the node buffer would hold fewer than 1024 nodes");
+    stats.nodeCapacity = nodeCapacity;
+
+    // history ramp power from the largest albedo
+    if (options.historyPower >= 0) {
+        historyPower = options.historyPower;
+    } else {
+        float rho = 0;
+        for (const auto& m : materials) rho = std::max({rho, m.albedo.r, m.albedo.g, m.albedo.b});
+        rho = std::min(rho, 0.99f);
+        historyPower = std::clamp(std::round(2.0 * rho / (1.0 - rho)), 1.0, 32.0);
+    }
+    stats.historyPower = historyPower;
+    directions = makeDirections(options.directions, options.seed);
+
+    Status s = buildPrograms();
+    if (!s) return s;
+    uploadMesh();
+    const int pages = layout.pageCount, res = layout.resolution;
+    albedoMap = gl::Texture::create2DArray("albedo map", GL_RGBA16F, res, res, pages);
+    emissionMap = gl::Texture::create2DArray("emission map", GL_RGBA16F, res, res, pages);
+    accum = gl::Texture::create2DArray("accumulators (fp16 RGB+W)", GL_RG32UI, res, res, pages);
+    sunMap = gl::Texture::create2DArray("direct sun map", GL_RGBA32F, res, res, pages);
+    radiance = gl::Texture::create2DArray("outgoing radiance map", GL_RGBA32F, res, res, pages);
+    scratch = gl::Texture::create2DArray("dilation scratch", GL_RGBA32F, res, res, pages);
+    glTextureParameteri(radiance.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(radiance.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(scratch.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(scratch.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    const uint32_t zeroU[4] = {0, 0, 0, 0};
+    const float zeroF[4] = {0, 0, 0, 0};
+    glClearTexImage(accum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, zeroU);
+    glClearTexImage(sunMap.id(), 0, GL_RGBA, GL_FLOAT, zeroF);
+    glClearTexImage(radiance.id(), 0, GL_RGBA, GL_FLOAT, zeroF);
+    heads = gl::Texture::create2D("bundle head pointers", GL_R32UI, maxTileSize, maxTileSize);
+    nodeBuffer = gl::Buffer::create("bundle nodes", nodeCapacity * 12, nullptr, 0);
+    counterBuffer = gl::Buffer::create("bundle node counter", 4, nullptr, GL_DYNAMIC_STORAGE_BIT);
+    stats.nodeBufferBytes = nodeBuffer.bytes();
+    stats.headImageBytes = heads.bytes();
+    bundleFbo = gl::Framebuffer::create("bundle framebuffer (no attachments)");
+    glNamedFramebufferParameteri(bundleFbo.id(), GL_FRAMEBUFFER_DEFAULT_WIDTH, maxTileSize);
+    glNamedFramebufferParameteri(bundleFbo.id(), GL_FRAMEBUFFER_DEFAULT_HEIGHT, maxTileSize);
+    pageFbo = gl::Framebuffer::create("light map page framebuffer (no attachments)");
+    glNamedFramebufferParameteri(pageFbo.id(), GL_FRAMEBUFFER_DEFAULT_WIDTH, res);
+    glNamedFramebufferParameteri(pageFbo.id(), GL_FRAMEBUFFER_DEFAULT_HEIGHT, res);
+
+    if (options.environment) {
+        const auto& env = *options.environment;
+        envTexture = gl::Texture::create2D("environment", GL_RGBA32F, env.width, env.height);
+        std::vector<glm::vec4> rgba(env.pixels.size());
+        for (size_t i = 0; i < rgba.size(); ++i) rgba[i] = glm::vec4(env.pixels[i], 1.0f);
+        // file row 0 is the top (theta = 0): texture t = theta / pi, so upload rows top-down as t = 0..1
+        glTextureSubImage2D(envTexture.id(), 0, 0, 0, env.width, env.height, GL_RGBA, GL_FLOAT, rgba.data());
+        glTextureParameteri(envTexture.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTextureParameteri(envTexture.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTextureParameteri(envTexture.id(), GL_TEXTURE_WRAP_S, GL_REPEAT);
+    }
+
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    metaPass(scene);
+
+    // coverage
+    std::vector<glm::u16vec4> texels(size_t(res) * res * pages);
+    glGetTextureImage(albedoMap.id(), 0, GL_RGBA, GL_HALF_FLOAT, GLsizei(texels.size() * 8), texels.data());
+    stats.lightmapTexels = int64_t(texels.size());
+    for (const auto& t : texels) stats.coveredTexels += t.w != 0;
+    stats.secondsSetup = secondsSince(t0);
+
+    auto ts = Clock::now();
+    bakeSun();
+    stats.secondsSun = secondsSince(ts);
+    auto tr = Clock::now();
+    resolveInto(true, radiance);
+    stats.secondsResolve += secondsSince(tr);
+    return Status::ok();
+}
+
+void Baker::Impl::setFrameUniforms(GLuint program, const glm::vec3& d, const glm::vec3& u, const glm::vec3& v,
+                                   glm::vec2 origin, const TileRect& tile) {
+    glUniform3fv(glGetUniformLocation(program, "bundleDir"), 1, &d.x);
+    glUniform3fv(glGetUniformLocation(program, "bundleU"), 1, &u.x);
+    glUniform3fv(glGetUniformLocation(program, "bundleV"), 1, &v.x);
+    glm::vec2 tileOrigin = origin + glm::vec2(tile.x, tile.y) * pixelSize;
+    glUniform2fv(glGetUniformLocation(program, "tileOrigin"), 1, &tileOrigin.x);
+    glUniform1f(glGetUniformLocation(program, "pixelSize"), pixelSize);
+    glUniform2i(glGetUniformLocation(program, "tileSize"), tile.width, tile.height);
+}
+
+double Baker::Impl::predictNodes(const glm::vec3& d) const {
+    // expected fragments = sum of projected triangle areas / pixel area
+    double sum = 0;
+    for (size_t t = 0; t < projectedArea.size(); ++t) sum += projectedArea[t] * std::abs(glm::dot(triangleNormal[t], d));
+    return sum / (double(pixelSize) * pixelSize);
+}
+
+template <class UpdateFn>
+void Baker::Impl::traceBundle(const glm::vec3& d, glm::vec2 jitter, uint32_t seed, UpdateFn update, bool recordStats) {
+    glm::vec3 u, v;
+    orthonormalBasis(d, u, v);
+    glm::vec2 origin = glm::vec2(glm::dot(sphereCenter, u), glm::dot(sphereCenter, v)) - glm::vec2(sphereRadius) +
+                       jitter * pixelSize;
+    // initial grid: tiles no larger than the head image, enough of them for the prediction to fit
+    double predicted = predictNodes(d);
+    int perSide = (gridSize + maxTileSize - 1) / maxTileSize;
+    while (predicted / (double(perSide) * perSide) > 0.8 * nodeCapacity && perSide < gridSize) perSide *= 2;
+    std::vector<std::pair<TileRect, double>> work;
+    int step = (gridSize + perSide - 1) / perSide;
+    for (int y = 0; y < gridSize; y += step)
+        for (int x = 0; x < gridSize; x += step)
+            work.push_back({TileRect{x, y, std::min(step, gridSize - x), std::min(step, gridSize - y)},
+                            predicted * double(std::min(step, gridSize - x)) * std::min(step, gridSize - y) /
+                                (double(gridSize) * gridSize)});
+    int tiles = 0;
+    const uint32_t endOfList = END_OF_LIST;
+    while (!work.empty()) {
+        auto [tile, tilePrediction] = work.back();
+        work.pop_back();
+        auto tb = Clock::now();
+        {
+            gl::DebugGroup group("bundle pass");
+            glClearTexSubImage(heads.id(), 0, 0, 0, 0, tile.width, tile.height, 1, GL_RED_INTEGER, GL_UNSIGNED_INT,
+                               &endOfList);
+            const uint32_t zero = 0;
+            glNamedBufferSubData(counterBuffer.id(), 0, 4, &zero);
+            glUseProgram(appendProgram.id());
+            setFrameUniforms(appendProgram.id(), d, u, v, origin, tile);
+            glUniform1ui(appendProgram.uniform("nodeCapacity"), uint32_t(std::min<int64_t>(nodeCapacity, 0xFFFFFFFEll)));
+            glUniform1ui(appendProgram.uniform("randomSeed"), pcgHash(seed ^ pcgHash(uint32_t(tile.x * 7919 + tile.y))));
+            glBindFramebuffer(GL_FRAMEBUFFER, bundleFbo.id());
+            glViewport(0, 0, tile.width, tile.height);
+            glBindVertexArray(vao.id());
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, triangleBuffer.id());
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_NODES, nodeBuffer.id());
+            glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, BINDING_NODE_COUNTER, counterBuffer.id());
+            glBindImageTexture(BINDING_HEADS, heads.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+            glBindTextureUnit(BINDING_RADIANCE, radiance.id());
+            glDrawArrays(GL_TRIANGLES, 0, GLsizei(mesh.vertices.size()));
+            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                            GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+        }
+        uint32_t count = 0;
+        glGetNamedBufferSubData(counterBuffer.id(), 0, 4, &count);
+        if (recordStats) stats.secondsBundle += secondsSince(tb);
+        ++tiles;
+        ++stats.tilesDrawn;
+        if (int64_t(count) > nodeCapacity) {
+            // overflow: nothing is used from this draw; split in four and redraw
+            ++stats.overflows;
+            CHECK(tile.width > 1 || tile.height > 1);
+            int hw = std::max(1, tile.width / 2), hh = std::max(1, tile.height / 2);
+            for (int k = 0; k < 4; ++k) {
+                TileRect t{tile.x + (k & 1) * hw, tile.y + (k >> 1) * hh, (k & 1) ? tile.width - hw : hw,
+                           (k >> 1) ? tile.height - hh : hh};
+                if (t.width > 0 && t.height > 0) work.push_back({t, tilePrediction / 4});
+            }
+            continue;
+        }
+        if (recordStats) {
+            stats.fragments += count;
+            stats.peakNodesPerTile = std::max<int64_t>(stats.peakNodesPerTile, count);
+            if (count > 0) stats.predictedOverActual.push_back(tilePrediction / count);
+        }
+        if (count == 0) continue;
+        auto tu = Clock::now();
+        {
+            gl::DebugGroup group("update pass");
+            glBindFramebuffer(GL_FRAMEBUFFER, pageFbo.id());
+            glViewport(0, 0, layout.resolution, layout.resolution);
+            update(d, u, v, origin, tile, count);
+            glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+        }
+        if (recordStats) {
+            glFinish();
+            stats.secondsUpdate += secondsSince(tu);
+        }
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (recordStats) stats.tilesPerDirection.push_back(tiles);
+}
+
+void Baker::Impl::bakeSun() {
+    if (lights.empty()) return;
+    int j = std::max(1, options.sunJitter);
+    for (size_t li = 0; li < lights.size(); ++li) {
+        const auto& light = lights[li];
+        glm::vec3 irradiance = light.irradiance;
+        for (int jy = 0; jy < j; ++jy)
+            for (int jx = 0; jx < j; ++jx) {
+                glm::vec2 jitter((jx + 0.5f) / j - 0.5f, (jy + 0.5f) / j - 0.5f);
+                traceBundle(glm::normalize(light.direction), jitter, uint32_t(li * 1000 + jy * j + jx),
+                    [&](const glm::vec3& d, const glm::vec3& u, const glm::vec3& v, glm::vec2 origin, const TileRect& tile,
+                        uint32_t count) {
+                        glUseProgram(sunProgram.id());
+                        glUniform1ui(sunProgram.uniform("nodeCount"), count);
+                        setFrameUniforms(sunProgram.id(), d, u, v, origin, tile);
+                        glUniform3fv(sunProgram.uniform("sunIrradiance"), 1, &irradiance.x);
+                        glUniform1f(sunProgram.uniform("depthBias"), depthBias);
+                        glBindImageTexture(BINDING_HEADS, heads.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
+                        glBindImageTexture(BINDING_SUN, sunMap.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
+                        for (int page = 0; page < layout.pageCount; ++page) {
+                            glUniform1i(sunProgram.uniform("page"), page);
+                            GLint first = GLint(mesh.pageFirstTriangle[page] * 3);
+                            GLsizei n = GLsizei((mesh.pageFirstTriangle[page + 1] - mesh.pageFirstTriangle[page]) * 3);
+                            if (n) glDrawArrays(GL_TRIANGLES, first, n);
+                        }
+                    },
+                    false);
+            }
+    }
+}
+
+void Baker::Impl::bakeDirection(int k) {
+    const glm::vec3 d = directions[size_t(k)];
+    // history ramp: weight min(k+1, K)^power relative to the stored scale
+    double rampEnd = std::max(1, options.directions / 2);
+    double weight = std::pow(std::min(double(k + 1), rampEnd), historyPower);
+    double sampleWeight = weight / accumScale;
+    if (sampleWeight > 16.0) {
+        gl::DebugGroup group("rescale accumulators");
+        glUseProgram(rescaleProgram.id());
+        glUniform1f(rescaleProgram.uniform("factor"), float(accumScale / weight));
+        glUniform1ui(rescaleProgram.uniform("randomSeed"), pcgHash(uint32_t(options.seed) ^ pcgHash(uint32_t(k) + 77u)));
+        glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
+        dispatchPages(rescaleProgram.id());
+        accumScale = weight;
+        sampleWeight = 1.0;
+    }
+    uint32_t seed = pcgHash(uint32_t(options.seed) * 0x9E3779B1u ^ pcgHash(uint32_t(k)));
+    bool useEnv = bool(envTexture);
+    traceBundle(d, glm::vec2(0.0f), seed,
+        [&](const glm::vec3& dd, const glm::vec3& u, const glm::vec3& v, glm::vec2 origin, const TileRect& tile,
+            uint32_t count) {
+            glUseProgram(updateProgram.id());
+            glUniform1ui(updateProgram.uniform("nodeCount"), count);
+            setFrameUniforms(updateProgram.id(), dd, u, v, origin, tile);
+            glUniform1f(updateProgram.uniform("sampleWeight"), float(sampleWeight));
+            glUniform1ui(updateProgram.uniform("randomSeed"), pcgHash(seed ^ uint32_t(tile.x * 131 + tile.y * 8191)));
+            glUniform3fv(updateProgram.uniform("sky"), 1, &options.sky.x);
+            glUniform1i(updateProgram.uniform("useEnv"), useEnv);
+            glUniform1f(updateProgram.uniform("depthBias"), depthBias);
+            if (useEnv) glBindTextureUnit(BINDING_ENV, envTexture.id());
+            glBindImageTexture(BINDING_HEADS, heads.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
+            glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
+            for (int page = 0; page < layout.pageCount; ++page) {
+                glUniform1i(updateProgram.uniform("page"), page);
+                GLint first = GLint(mesh.pageFirstTriangle[page] * 3);
+                GLsizei n = GLsizei((mesh.pageFirstTriangle[page + 1] - mesh.pageFirstTriangle[page]) * 3);
+                if (n) glDrawArrays(GL_TRIANGLES, first, n);
+            }
+        },
+        true);
+    stats.updatedTexels += stats.coveredTexels;
+    auto tr = Clock::now();
+    resolveInto(true, radiance);
+    glFinish();
+    stats.secondsResolve += secondsSince(tr);
+    ++stats.directionsDone;
+}
+
+void Baker::Impl::resolveInto(bool radianceOut, gl::Texture& target) {
+    gl::DebugGroup group("resolve");
+    gl::Texture& other = (&target == &radiance) ? scratch : radiance;
+    glUseProgram(resolveProgram.id());
+    glUniform1i(resolveProgram.uniform("radianceOut"), radianceOut);
+    glBindImageTexture(1, accum.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RG32UI);
+    glBindImageTexture(2, sunMap.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
+    glBindImageTexture(3, albedoMap.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
+    glBindImageTexture(4, emissionMap.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
+    glBindImageTexture(5, target.id(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    dispatchPages(resolveProgram.id());
+    // an even number of passes ends in `target`
+    int passes = 2 * ((std::max(layout.padding, 1) + 2) / 2);
+    gl::Texture* result = dilate(target, other, passes);
+    CHECK(result == &target);
+}
+
+gl::Texture* Baker::Impl::dilate(gl::Texture& first, gl::Texture& second, int passes) {
+    glUseProgram(dilateProgram.id());
+    gl::Texture* src = &first;
+    gl::Texture* dst = &second;
+    for (int i = 0; i < passes; ++i) {
+        glBindImageTexture(5, src->id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
+        glBindImageTexture(6, dst->id(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+        dispatchPages(dilateProgram.id());
+        std::swap(src, dst);
+    }
+    return src;
+}
+
+Baker::Baker(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Baker::~Baker() = default;
+
+Expected<std::unique_ptr<Baker>> Baker::create(const Scene& scene, const Layout& layout, const BakeOptions& options) {
+    auto impl = std::make_unique<Impl>();
+    impl->options = options;
+    impl->layout = layout;
+    impl->mesh = buildBakeMesh(scene, layout);
+    MemoryTracker::gpu().resetPeak();
+    Status s = impl->init(scene);
+    if (!s) return s;
+    return std::unique_ptr<Baker>(new Baker(std::move(impl)));
+}
+
+BakeProgress Baker::step(double seconds) {
+    auto t0 = Clock::now();
+    while (impl_->stats.directionsDone < impl_->options.directions) {
+        impl_->bakeDirection(impl_->stats.directionsDone);
+        if (secondsSince(t0) >= seconds) break;
+    }
+    impl_->stats.peakGpuBytes = MemoryTracker::gpu().peak();
+    return progress();
+}
+
+BakeProgress Baker::progress() const { return {impl_->stats.directionsDone, impl_->options.directions}; }
+
+LightmapPages Baker::readLightmaps() {
+    Impl& m = *impl_;
+    m.resolveInto(false, m.scratch);
+    const int res = m.layout.resolution;
+    std::vector<glm::vec4> texels(size_t(res) * res * m.layout.pageCount);
+    glGetTextureImage(m.scratch.id(), 0, GL_RGBA, GL_FLOAT, GLsizei(texels.size() * 16), texels.data());
+    std::vector<glm::u16vec4> albedo(texels.size());
+    glGetTextureImage(m.albedoMap.id(), 0, GL_RGBA, GL_HALF_FLOAT, GLsizei(albedo.size() * 8), albedo.data());
+    // restore the radiance map (resolveInto used it as dilation scratch)
+    m.resolveInto(true, m.radiance);
+    LightmapPages out;
+    out.resolution = res;
+    for (int p = 0; p < m.layout.pageCount; ++p) {
+        io::ImageRgb img;
+        img.width = img.height = res;
+        img.pixels.resize(size_t(res) * res);
+        std::vector<uint8_t> cov(size_t(res) * res);
+        for (size_t i = 0; i < img.pixels.size(); ++i) {
+            size_t k = size_t(p) * res * res + i;
+            img.pixels[i] = glm::vec3(texels[k]);
+            cov[i] = albedo[k].w != 0;
+        }
+        out.pages.push_back(std::move(img));
+        out.covered.push_back(std::move(cov));
+    }
+    return out;
+}
+
+std::vector<std::vector<glm::vec4>> Baker::readAccumulators() {
+    Impl& m = *impl_;
+    const int res = m.layout.resolution;
+    std::vector<glm::uvec2> raw(size_t(res) * res * m.layout.pageCount);
+    glGetTextureImage(m.accum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, GLsizei(raw.size() * 8), raw.data());
+    std::vector<std::vector<glm::vec4>> out(size_t(m.layout.pageCount));
+    for (int p = 0; p < m.layout.pageCount; ++p)
+        for (int i = 0; i < res * res; ++i) {
+            glm::uvec2 v = raw[size_t(p) * res * res + i];
+            out[size_t(p)].push_back(glm::vec4(halfToFloat(uint16_t(v.x & 0xFFFF)), halfToFloat(uint16_t(v.x >> 16)),
+                                               halfToFloat(uint16_t(v.y & 0xFFFF)), halfToFloat(uint16_t(v.y >> 16))));
+        }
+    return out;
+}
+
+Baker::BundleCapture Baker::captureBundle(const glm::vec3& dir) {
+    Impl& m = *impl_;
+    CHECK_LE(m.gridSize, m.maxTileSize);
+    BundleCapture cap;
+    cap.dir = glm::normalize(dir);
+    m.traceBundle(cap.dir, glm::vec2(0.0f), 12345u,
+        [&](const glm::vec3& d, const glm::vec3& u, const glm::vec3& v, glm::vec2 origin, const TileRect& tile,
+            uint32_t) {
+            cap.u = u;
+            cap.v = v;
+            cap.origin = origin;
+            cap.pixelSize = m.pixelSize;
+            cap.width = tile.width;
+            cap.height = tile.height;
+            (void)d;
+        },
+        false);
+    glGetNamedBufferSubData(m.counterBuffer.id(), 0, 4, &cap.nodeCount);
+    if (cap.width == 0) return cap;  // nothing drawn
+    std::vector<uint32_t> heads(size_t(m.maxTileSize) * m.maxTileSize);
+    glGetTextureImage(m.heads.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, GLsizei(heads.size() * 4), heads.data());
+    std::vector<shared::Node> nodes(std::max<uint32_t>(cap.nodeCount, 1));
+    glGetNamedBufferSubData(m.nodeBuffer.id(), 0, GLsizeiptr(nodes.size() * sizeof(shared::Node)), nodes.data());
+    cap.depths.resize(size_t(cap.width) * cap.height);
+    cap.flags.resize(cap.depths.size());
+    cap.radiance.resize(cap.depths.size());
+    for (int y = 0; y < cap.height; ++y)
+        for (int x = 0; x < cap.width; ++x) {
+            std::vector<std::pair<float, uint32_t>> list;
+            uint32_t steps = 0;
+            for (uint32_t i = heads[size_t(y) * m.maxTileSize + x]; i != END_OF_LIST; i = nodes[i].next) {
+                if (i >= cap.nodeCount || ++steps > cap.nodeCount) {
+                    cap.listsWellFormed = false;
+                    break;
+                }
+                list.push_back({0.0f, i});
+                std::memcpy(&list.back().first, &nodes[i].depth, 4);
+            }
+            std::sort(list.begin(), list.end());
+            size_t k = size_t(y) * cap.width + x;
+            for (auto& [z, i] : list) {
+                cap.depths[k].push_back(z);
+                cap.flags[k].push_back(nodes[i].depth & NODE_FLAG_MASK);
+                cap.radiance[k].push_back(decodeRgbe(nodes[i].radiance));
+            }
+        }
+    return cap;
+}
+
+const BakeStats& Baker::stats() const { return impl_->stats; }
+const BakeMesh& Baker::mesh() const { return impl_->mesh; }
+
+}  // namespace bb

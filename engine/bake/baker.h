@@ -1,0 +1,133 @@
+// The ray-bundle baker: diffuse global illumination (all bounces) into light
+// maps by radiance exchange along ray bundles on the GL 4.3 raster pipeline.
+//
+// Based on: Y. Tokuyoshi, T. Sekine, T. da Silva, T. Kanai, "Adaptive
+// Ray-bundle Tracing with Memory Usage Prediction: Efficient Global
+// Illumination in Large Scenes", CGF 32(7), 2013 (supplement §2-3), and
+// J. Hermes, N. Henrich, T. Grosch, S. Mueller, "Global Illumination using
+// Parallel Global Ray-Bundles", VMV 2010.
+//
+// A bake you can step (lightmapper's lmBegin/lmEnd idea): the CLI loops on
+// step(), the viewer calls it once per frame; one code path, one seed, the
+// same bytes. Requires a current GL 4.3 context for its whole life.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+
+#include "bake/rounding.h"
+#include "core/status.h"
+#include "io/image_io.h"
+#include "layout/bake_mesh.h"
+#include "layout/layout.h"
+#include "scene/scene.h"
+
+namespace bb {
+
+struct BakeOptions {
+    int directions = 256;             // bundle directions (each serves d and -d); typ. 64..4096
+    int bundleResolution = 0;         // pixels across the scene's bounding sphere; 0 = from the texel
+                                      // density (pixel = half a texel: no leaks through walls >= 1 texel)
+    int64_t memoryBudget = 512ll << 20;  // bytes for the node buffer + head image of one tile
+    uint64_t seed = 1;
+    glm::vec3 sky{0.0f};              // uniform sky radiance (scene units)
+    std::optional<io::ImageRgb> environment;  // equirectangular environment radiance; replaces sky
+    Rounding rounding = Rounding::Stochastic;
+    // History ramp: direction k is weighted min(k, directions/2)^power, so early
+    // directions (which saw light maps with few bounces) fade out. < 0 = from
+    // the scene's largest albedo: round(2 rho / (1 - rho)), clamped to [1, 32].
+    float historyPower = -1.0f;
+    int sunJitter = 2;                // sun bundles per axis (jittered sub-pixel), for antialiased shadows
+};
+
+// Figures every bake reports (stats.json).
+struct BakeStats {
+    int directionsDone = 0;
+    int directionsTotal = 0;
+    double bundleResolution = 0;      // pixels across the bounding sphere
+    double pixelSize = 0;             // scene units
+    double historyPower = 0;
+    int64_t tilesDrawn = 0;
+    int64_t overflows = 0;            // tiles whose node count exceeded capacity and were split and redrawn
+    int64_t fragments = 0;            // nodes appended (kept), over all tiles
+    int64_t updatedTexels = 0;        // texel samples accumulated
+    int64_t peakNodesPerTile = 0;
+    int64_t nodeCapacity = 0;
+    int64_t nodeBufferBytes = 0;
+    int64_t headImageBytes = 0;
+    int64_t peakGpuBytes = 0;
+    int64_t lightmapTexels = 0;
+    int64_t coveredTexels = 0;
+    std::vector<double> predictedOverActual;  // per tile: predicted nodes / actual nodes
+    std::vector<int> tilesPerDirection;
+    double secondsSetup = 0, secondsSun = 0, secondsBundle = 0, secondsUpdate = 0, secondsResolve = 0;
+    double secondsTotal() const { return secondsSetup + secondsSun + secondsBundle + secondsUpdate + secondsResolve; }
+    nlohmann::json toJson() const;
+};
+
+struct BakeProgress {
+    int directionsDone = 0;
+    int directionsTotal = 0;
+    bool done() const { return directionsDone >= directionsTotal; }
+};
+
+// The light maps of a bake: one image per page, L_lm = E/pi (DESIGN.md Units),
+// texel row 0 = v 0 (GL order), padding dilated. `covered` marks texels whose
+// centre lies on a triangle.
+struct LightmapPages {
+    int resolution = 0;
+    std::vector<io::ImageRgb> pages;
+    std::vector<std::vector<uint8_t>> covered;
+};
+
+class Baker {
+public:
+    // Uploads the scene, rasterizes albedo/emission into light map space and
+    // bakes the direct sun. Errors: scene too large for the GL limits, bad options.
+    static Expected<std::unique_ptr<Baker>> create(const Scene& scene, const Layout& layout, const BakeOptions& options);
+    ~Baker();
+
+    // Bakes directions until `seconds` have passed (at least one direction,
+    // unless done). Deterministic whatever the budget: the same directions in
+    // the same order give the same bytes.
+    BakeProgress step(double seconds);
+    BakeProgress progress() const;
+
+    // Reads the current light maps back (resolve + dilate on the GPU).
+    LightmapPages readLightmaps();
+    // Raw accumulator read-back for tests: per page, per texel (R, G, B, W) as stored in fp16.
+    std::vector<std::vector<glm::vec4>> readAccumulators();
+
+    // One bundle along d drawn as a single tile, read back (tests, tools):
+    // per pixel, the depths of its list (sorted), and the frame to cast rays
+    // through pixel centres on the CPU. Precondition: the bundle fits one tile.
+    struct BundleCapture {
+        glm::vec3 dir{0.0f}, u{0.0f}, v{0.0f};
+        glm::vec2 origin{0.0f};   // (u, v) of pixel (0, 0)'s lower-left corner
+        float pixelSize = 0.0f;
+        int width = 0, height = 0;
+        uint32_t nodeCount = 0;   // the atomic counter
+        std::vector<std::vector<float>> depths;       // [y * width + x], ascending
+        std::vector<std::vector<uint32_t>> flags;     // NODE_VISIBLE_* per depth (same order)
+        std::vector<std::vector<glm::vec3>> radiance; // decoded RGBE per depth (same order)
+        bool listsWellFormed = true;                  // no cycle, every index < nodeCount
+    };
+    BundleCapture captureBundle(const glm::vec3& dir);
+
+    const BakeStats& stats() const;
+    const BakeMesh& mesh() const;
+
+    struct Impl;
+
+private:
+    explicit Baker(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace bb

@@ -1,0 +1,24 @@
+// Bundle directions: a stratified set over the hemisphere z > 0 (spherical
+// Fibonacci), rotated by a seeded random rotation. Each direction d serves d
+// and -d (a texel takes the side its normal faces), so {+-d_i} covers the
+// sphere uniformly and every texel gets one sample per direction.
+//
+// Order: a low-discrepancy permutation of the Fibonacci indices (van der
+// Corput on the index), so every prefix of the sequence is itself spread over
+// the hemisphere: a bake stopped early (viewer, checkpoints) is still stratified.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace bb {
+
+// count >= 1. Unit vectors; the same (count, seed) gives the same bits.
+std::vector<glm::vec3> makeDirections(int count, uint64_t seed);
+
+// A right-handed orthonormal basis (u, v) with u x v = d, for bundle planes.
+void orthonormalBasis(const glm::vec3& d, glm::vec3& u, glm::vec3& v);
+
+}  // namespace bb

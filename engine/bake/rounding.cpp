@@ -1,0 +1,106 @@
+// fp16 and RGBE encodings with stochastic (unbiased) or nearest rounding, and
+// the PCG hash that feeds them random numbers. glsl/lib/rounding.glsl is the
+// GPU twin; keep the two in step.
+//
+// Based on: Connolly, Higham, Mary, "Stochastic rounding and its probabilistic
+// backward error analysis", SIAM J. Sci. Comput. 43(1), 2021 (mode 1: round up
+// with probability proportional to the distance from the lower neighbour);
+// Ward, "Real Pixels", Graphics Gems II, 1991 (RGBE); Jarzynski and Olano,
+// "Hash Functions for GPU Rendering", JCGT 9(3), 2020 (PCG hash).
+#include "bake/rounding.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <Imath/half.h>
+
+namespace bb {
+namespace {
+
+constexpr uint16_t SIGN_BIT = 0x8000;
+constexpr uint16_t LARGEST_HALF_BITS = 0x7BFF;  // 65504, the largest finite fp16
+constexpr float LARGEST_HALF = 65504.0f;
+
+// Round a non-negative mantissa to an integer: floor(m + u), u = 0.5 for nearest.
+uint32_t roundMantissa(float m, float u) { return uint32_t(std::floor(m + u)); }
+
+}  // namespace
+
+uint16_t floatToHalf(float x, Rounding mode, float u) {
+    if (std::isnan(x)) return 0;
+    const uint16_t sign = x < 0.0f ? SIGN_BIT : 0;  // as the GLSL twin: -0 -> +0
+    // saturate: anything at or beyond the largest finite half (Inf included)
+    const float a = std::fabs(x);
+    if (a >= LARGEST_HALF) return sign | LARGEST_HALF_BITS;
+
+    // nearest, ties to even (Imath); only 65504 < a < 65520 could round to Inf,
+    // and those were caught above
+    uint16_t h = imath_float_to_half(a);
+    if (mode == Rounding::Nearest) return sign | h;
+
+    const float v = imath_half_to_float(h);
+    if (v == a) return sign | h;
+    // the two neighbours bracketing a: positive halves are monotonic in their bits
+    const uint16_t lo = v < a ? h : uint16_t(h - 1);
+    const uint16_t hi = uint16_t(lo + 1);
+    const float vlo = imath_half_to_float(lo);
+    const float vhi = imath_half_to_float(hi);
+    // pick hi with probability (a - vlo) / (vhi - vlo). Both differences are
+    // exact (Sterbenz; vhi - vlo is a power of two), written as the GLSL twin
+    // writes it so the two agree bit for bit.
+    h = (u * (vhi - vlo) < a - vlo) ? hi : lo;
+    return sign | std::min(h, LARGEST_HALF_BITS);
+}
+
+float halfToFloat(uint16_t h) { return imath_half_to_float(h); }
+
+uint32_t encodeRgbe(glm::vec3 rgb, Rounding mode, glm::vec3 u) {
+    // negatives and NaN -> 0 (the comparison is false for NaN); +Inf -> the
+    // largest float, which then saturates below like any value >= 2^127
+    for (int i = 0; i < 3; ++i) rgb[i] = rgb[i] > 0.0f ? std::min(rgb[i], std::numeric_limits<float>::max()) : 0.0f;
+    const float maxc = std::max(rgb.r, std::max(rgb.g, rgb.b));
+    if (!(maxc >= 1e-38f)) return 0;
+    if (mode == Rounding::Nearest) u = glm::vec3(0.5f);
+
+    int e = 0;
+    std::frexp(maxc, &e);  // maxc = f * 2^e, f in [0.5, 1), so maxc < 2^e
+    for (int attempt = 0; attempt < 2; ++attempt) {
+        // the largest exponent byte is 255 (e = 127): beyond it (maxc >= 2^127)
+        // saturate the mantissas at 255
+        const int es = std::min(e, 127);
+        // ldexp, not x * exp2(8 - e): 2^(8 - e) overflows a float for maxc < 2^-120
+        uint32_t q[3];
+        for (int i = 0; i < 3; ++i) q[i] = roundMantissa(std::min(std::ldexp(rgb[i], 8 - es), 256.0f), u[i]);
+        if (e > 127) {
+            for (uint32_t& qi : q) qi = std::min(qi, 255u);
+        }
+        if (std::max(q[0], std::max(q[1], q[2])) < 256u) {
+            // e >= -125 for maxc >= 1e-38, so the byte is >= 3: never the "zero" byte
+            const uint32_t eb = uint32_t(std::clamp(es + 128, 0, 255));
+            return q[0] | (q[1] << 8) | (q[2] << 16) | (eb << 24);
+        }
+        // a mantissa rounded up to 256: carry into the exponent and round again
+        // with the same u (the largest mantissa then rounds to 128 exactly)
+        e += 1;
+    }
+    return 0;  // unreachable: after the carry every mantissa is <= 128
+}
+
+glm::vec3 decodeRgbe(uint32_t rgbe) {
+    const int eb = int(rgbe >> 24);
+    if (eb == 0) return glm::vec3(0.0f);
+    const glm::vec3 m(float(rgbe & 255u), float((rgbe >> 8) & 255u), float((rgbe >> 16) & 255u));
+    // ldexp keeps tiny exponents exact where exp2 * m would not
+    return glm::vec3(std::ldexp(m.r, eb - 136), std::ldexp(m.g, eb - 136), std::ldexp(m.b, eb - 136));
+}
+
+uint32_t pcgHash(uint32_t v) {
+    const uint32_t state = v * 747796405u + 2891336453u;
+    const uint32_t word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+float uniform01(uint32_t bits) { return float(bits >> 8) * (1.0f / 16777216.0f); }
+
+}  // namespace bb

@@ -1,0 +1,105 @@
+// Move-only RAII owners of GL names, each labelled with glObjectLabel so
+// debug output and captures name them. Buffers and textures report their
+// bytes to MemoryTracker::gpu(). Requires a current context for create/destroy.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <utility>
+
+#include "gl/gl.h"
+
+namespace bb::gl {
+
+// Base: owns one name of a kind; `destroy` is the kind's delete call.
+template <class Derived>
+class Object {
+public:
+    Object() = default;
+    Object(const Object&) = delete;
+    Object& operator=(const Object&) = delete;
+    Object(Object&& o) noexcept : name_(std::exchange(o.name_, 0)), bytes_(std::exchange(o.bytes_, 0)) {}
+    Object& operator=(Object&& o) noexcept {
+        if (this != &o) {
+            reset();
+            name_ = std::exchange(o.name_, 0);
+            bytes_ = std::exchange(o.bytes_, 0);
+        }
+        return *this;
+    }
+    ~Object() { reset(); }
+
+    GLuint id() const { return name_; }
+    explicit operator bool() const { return name_ != 0; }
+    int64_t bytes() const { return bytes_; }
+    void reset();
+
+protected:
+    void adopt(GLuint name, GLenum labelKind, const std::string& label);
+    void setBytes(int64_t bytes);
+    GLuint name_ = 0;
+    int64_t bytes_ = 0;
+};
+
+class Buffer : public Object<Buffer> {
+public:
+    // Immutable-size storage (glNamedBufferStorage) with `flags`
+    // (e.g. GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT). data may be null.
+    static Buffer create(const std::string& label, int64_t size, const void* data, GLbitfield flags);
+    static void destroy(GLuint name) { glDeleteBuffers(1, &name); }
+};
+
+class Texture : public Object<Texture> {
+public:
+    // 2D texture with one level, immutable storage of `internalFormat`.
+    static Texture create2D(const std::string& label, GLenum internalFormat, int width, int height);
+    // 2D texture with `levels` mip levels (call glGenerateTextureMipmap after upload).
+    static Texture create2DLevels(const std::string& label, GLenum internalFormat, int width, int height, int levels);
+    // 2D array texture, one level, `layers` layers (light map pages).
+    static Texture create2DArray(const std::string& label, GLenum internalFormat, int width, int height, int layers);
+    static void destroy(GLuint name) { glDeleteTextures(1, &name); }
+    // Takes ownership of an existing texture name (labels it, tracks its bytes).
+    static Texture adoptTexture(GLuint name, const std::string& label, GLenum internalFormat, int width, int height,
+                                int layers, int levels);
+    int width = 0, height = 0, layers = 1;
+    GLenum format = 0;
+};
+
+class Framebuffer : public Object<Framebuffer> {
+public:
+    static Framebuffer create(const std::string& label);
+    static void destroy(GLuint name) { glDeleteFramebuffers(1, &name); }
+};
+
+class VertexArray : public Object<VertexArray> {
+public:
+    static VertexArray create(const std::string& label);
+    static void destroy(GLuint name) { glDeleteVertexArrays(1, &name); }
+};
+
+class Query : public Object<Query> {
+public:
+    static Query create(const std::string& label, GLenum target);
+    static void destroy(GLuint name) { glDeleteQueries(1, &name); }
+};
+
+class Program : public Object<Program> {
+public:
+    static Program adoptName(GLuint name, const std::string& label);
+    static void destroy(GLuint name) { glDeleteProgram(name); }
+    GLint uniform(const char* name) const { return glGetUniformLocation(name_, name); }
+};
+
+// Bytes per texel of the internal formats the engine uses.
+int bytesPerTexel(GLenum internalFormat);
+
+// A debug group for the lifetime of the object (glPushDebugGroup/Pop).
+class DebugGroup {
+public:
+    explicit DebugGroup(const char* name);
+    ~DebugGroup();
+    DebugGroup(const DebugGroup&) = delete;
+    DebugGroup& operator=(const DebugGroup&) = delete;
+};
+
+}  // namespace bb::gl

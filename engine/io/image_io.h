@@ -1,0 +1,53 @@
+// Image and JSON output through OpenImageIO and nlohmann-json. Every writer
+// goes to "<path>.tmp-<pid>" first and renames over `path`, so OUTDIR never
+// holds a partial or corrupt file.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+
+#include "core/status.h"
+
+namespace bb::io {
+
+// A linear RGB float image, row-major, row 0 = top of the file (as EXR/PNG store
+// it). Light map pages are stored with texel row 0 (v = 0) at the *bottom*:
+// callers flip with flipRows() when going between GL order and file order.
+struct ImageRgb {
+    int width = 0, height = 0;
+    std::vector<glm::vec3> pixels;
+    glm::vec3& at(int x, int y) { return pixels[size_t(y) * width + x]; }
+    const glm::vec3& at(int x, int y) const { return pixels[size_t(y) * width + x]; }
+};
+
+void flipRows(ImageRgb& image);
+
+// Half-float RGB EXR (OpenEXR via OIIO), ZIP compression, plus string
+// attributes (e.g. "bundlebake:units" = "L_lm = E/pi").
+Status writeExrHalf(const std::string& path, const ImageRgb& image,
+                    const std::vector<std::pair<std::string, std::string>>& attributes = {});
+
+// Reads any OIIO-readable image (EXR, HDR, PNG...) as linear RGB float
+// (8-bit formats are taken as sRGB and linearized). Error names the file.
+Expected<ImageRgb> readImageRgb(const std::string& path);
+
+// 8-bit sRGB PNG of a linear image: scaled by 2^exposure, then ACES-fitted
+// filmic tone map (Narkowicz 2015), then sRGB encoding.
+Status writePngToneMapped(const std::string& path, const ImageRgb& image, float exposure = 0.0f);
+
+// 8-bit PNG written as is (values clamped to [0,1], sRGB-encoded if `srgb`).
+Status writePng(const std::string& path, const ImageRgb& image, bool srgb = true);
+
+// Pretty-printed JSON (2-space indent), atomically.
+Status writeJson(const std::string& path, const nlohmann::json& value);
+
+// Writes bytes atomically (temp + rename).
+Status writeFileAtomic(const std::string& path, const std::string& bytes);
+
+// Creates a directory (and parents); error if it exists as a file or cannot be made.
+Status ensureDirectory(const std::string& path);
+
+}  // namespace bb::io

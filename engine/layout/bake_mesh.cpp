@@ -1,0 +1,101 @@
+// The scene flattened into world space with page-space light map UVs.
+//
+// Based on: DESIGN.md "Data flow" steps 2 and 6-7 (one vertex array for every
+// pass). Normals go through the inverse transpose of the linear part of
+// worldFromObject; mirroring transforms (det < 0) swap two vertices so that
+// counter-clockwise stays the front face.
+#include "layout/bake_mesh.h"
+
+#include <cmath>
+
+#include "core/check.h"
+
+namespace bb {
+namespace {
+
+bool emits(const Material& material) {
+    return material.emission.r > 0.0f || material.emission.g > 0.0f || material.emission.b > 0.0f;
+}
+
+}  // namespace
+
+BakeMesh buildBakeMesh(const Scene& scene, const Layout& layout) {
+    CHECK_EQ(layout.rects.size(), scene.instances.size());
+    const size_t pageCount = size_t(layout.pageCount);
+
+    // count triangles per page, so they can be written in page order directly
+    // (a stable counting sort: instance order is kept within a page)
+    std::vector<uint32_t> first(pageCount + 1, 0);
+    for (size_t i = 0; i < scene.instances.size(); ++i) {
+        const Instance& inst = scene.instances[i];
+        CHECK(inst.mesh >= 0 && size_t(inst.mesh) < scene.meshes.size());
+        const InstanceRect& rect = layout.rects[i];
+        CHECK(rect.page >= 0 && size_t(rect.page) < pageCount);
+        size_t triangles = 0;
+        for (const Primitive& prim : scene.meshes[size_t(inst.mesh)].primitives) triangles += prim.triangleCount();
+        first[size_t(rect.page) + 1] += uint32_t(triangles);
+    }
+    for (size_t p = 0; p < pageCount; ++p) first[p + 1] += first[p];
+
+    BakeMesh out;
+    out.triangles.resize(first[pageCount]);
+    out.vertices.resize(size_t(first[pageCount]) * 3);
+    std::vector<uint32_t> cursor(first.begin(), first.end() - 1);
+
+    for (size_t i = 0; i < scene.instances.size(); ++i) {
+        const Instance& inst = scene.instances[i];
+        const InstanceRect& rect = layout.rects[i];
+        const glm::mat4& worldFromObject = inst.worldFromObject;
+        const glm::mat3 linear(worldFromObject);
+        const glm::mat3 normalFromObject = glm::transpose(glm::inverse(linear));
+        const bool mirrored = glm::determinant(linear) < 0.0f;
+        // vertex order that keeps front faces front (swap 1 and 2 when mirrored)
+        const int order[3] = {0, mirrored ? 2 : 1, mirrored ? 1 : 2};
+
+        for (const Primitive& prim : scene.meshes[size_t(inst.mesh)].primitives) {
+            if (prim.triangleCount() == 0) continue;
+            CHECK(prim.material >= 0 && size_t(prim.material) < scene.materials.size());
+            // the layout guarantees TEXCOORD_1 on every instanced primitive
+            CHECK_EQ(prim.uv1.size(), prim.positions.size());
+            const bool hasNormals = prim.normals.size() == prim.positions.size();
+            const bool hasUv0 = prim.uv0.size() == prim.positions.size();
+            const Material& material = scene.materials[size_t(prim.material)];
+            uint32_t flags = 0;
+            if (material.doubleSided) flags |= TRIANGLE_DOUBLE_SIDED;
+            if (emits(material)) flags |= TRIANGLE_EMISSIVE;
+
+            for (size_t t = 0; t < prim.triangleCount(); ++t) {
+                const uint32_t slot = cursor[size_t(rect.page)]++;
+                out.triangles[slot] = BakeTriangle{uint32_t(prim.material), uint32_t(rect.page), uint32_t(i), flags};
+                BakeVertex* v = &out.vertices[size_t(slot) * 3];
+                for (int k = 0; k < 3; ++k) {
+                    const uint32_t index = prim.indices[3 * t + size_t(order[k])];
+                    DCHECK(index < prim.positions.size());
+                    const glm::vec3 world = glm::vec3(worldFromObject * glm::vec4(prim.positions[index], 1.0f));
+                    v[k].position = glm::vec4(world, 1.0f);
+                    out.bounds.extend(world);
+                    v[k].uv0 = hasUv0 ? prim.uv0[index] : glm::vec2(0.0f);
+                    v[k].lightmapUv = prim.uv1[index] * rect.scale + rect.offset;
+                    v[k].normal = glm::vec4(0.0f);
+                    if (hasNormals) {
+                        const glm::vec3 n = normalFromObject * prim.normals[index];
+                        const float len = glm::length(n);
+                        if (len > 0.0f && std::isfinite(len)) v[k].normal = glm::vec4(n / len, 0.0f);
+                    }
+                }
+                // missing or degenerate normals: the face normal of the (re-ordered) triangle
+                const glm::vec3 face = glm::cross(glm::vec3(v[1].position - v[0].position),
+                                                  glm::vec3(v[2].position - v[0].position));
+                const float faceLen = glm::length(face);
+                for (int k = 0; k < 3; ++k) {
+                    if (v[k].normal == glm::vec4(0.0f) && faceLen > 0.0f)
+                        v[k].normal = glm::vec4(face / faceLen, 0.0f);
+                }
+            }
+        }
+    }
+    out.pageFirstTriangle = std::move(first);
+    return out;
+}
+
+}  // namespace bb

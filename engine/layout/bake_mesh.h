@@ -1,0 +1,50 @@
+// The scene flattened for baking: every instance's triangles in world space,
+// with light map coordinates already in page space. One vertex array for all
+// GL passes (bundle, update, importance, viewer) and the CPU reference.
+//
+// GL-free. Vertex layout is std430-friendly (no vec3 members): it is uploaded
+// as-is into a vertex buffer.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "glsl/shared/mesh_layout.h"  // TRIANGLE_DOUBLE_SIDED, TRIANGLE_EMISSIVE
+#include "layout/layout.h"
+#include "scene/scene.h"
+
+namespace bb {
+
+struct BakeVertex {
+    glm::vec4 position;   // xyz world position, w = 1
+    glm::vec4 normal;     // xyz world unit normal (shading), w = 0
+    glm::vec2 uv0;        // material texture coordinates (TEXCOORD_0, 0 if absent)
+    glm::vec2 lightmapUv; // page-space light map coordinates in [0,1]^2
+};
+static_assert(sizeof(BakeVertex) == 48);
+
+struct BakeTriangle {
+    uint32_t material;    // index into Scene::materials
+    uint32_t page;        // light map page
+    uint32_t instance;    // index into Scene::instances
+    uint32_t flags;       // TRIANGLE_DOUBLE_SIDED, TRIANGLE_EMISSIVE
+};
+static_assert(sizeof(BakeTriangle) == 16);
+
+
+struct BakeMesh {
+    std::vector<BakeVertex> vertices;     // 3 per triangle, not shared (simple, and normals may differ)
+    std::vector<BakeTriangle> triangles;
+    std::vector<uint32_t> pageFirstTriangle;  // triangles are sorted by page; page p is [first[p], first[p+1])
+    Bounds bounds;
+    size_t triangleCount() const { return triangles.size(); }
+};
+
+// Transforms every instance into world space (normals by the inverse
+// transpose), maps TEXCOORD_1 through the instance's rectangle, sorts
+// triangles by page. Precondition: layout was computed for this scene.
+BakeMesh buildBakeMesh(const Scene& scene, const Layout& layout);
+
+}  // namespace bb

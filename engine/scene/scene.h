@@ -1,0 +1,130 @@
+// The scene as bundlebake sees it: glTF 2.0 meshes, materials, instances,
+// directional lights and cameras, in scene units (whatever the file uses;
+// glTF means metres, the shared Cornell box uses millimetres).
+//
+// GL-free: plain structs, loaded by loadScene() (gltf_loader.cpp, tinygltf).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/status.h"
+
+namespace bb {
+
+// Linear-RGB float image (8-bit sRGB sources are decoded to linear on load).
+struct Texture {
+    std::string name;
+    int width = 0;
+    int height = 0;
+    std::vector<glm::vec4> texels;  // row-major, texels[y * width + x], y = 0 is the top row
+};
+
+// Diffuse view of a glTF metallic-roughness material.
+struct Material {
+    std::string name;
+    glm::vec3 albedo{0.8f};        // baseColorFactor.rgb * (1 - metallicFactor)
+    int albedoTexture = -1;        // index into Scene::textures, multiplies albedo (TEXCOORD_0)
+    glm::vec3 emission{0.0f};      // emissiveFactor * KHR_materials_emissive_strength: radiance, scene units
+    int emissionTexture = -1;      // index into Scene::textures, multiplies emission (TEXCOORD_0)
+    bool doubleSided = false;
+    bool isDefault = false;        // made by bundlebake for primitives without a material
+};
+
+// One triangle list. Indices are always present (non-indexed glTF primitives
+// get 0..n-1); degenerate triangles are removed on load and counted.
+struct Primitive {
+    std::vector<glm::vec3> positions;  // object space
+    std::vector<glm::vec3> normals;    // object space, unit; computed flat if the file has none
+    std::vector<glm::vec2> uv0;        // TEXCOORD_0, empty if absent
+    std::vector<glm::vec2> uv1;        // TEXCOORD_1 (light map UVs), empty if absent
+    std::vector<uint32_t> indices;     // 3 per triangle
+    int material = -1;                 // index into Scene::materials (always valid after load)
+    size_t triangleCount() const { return indices.size() / 3; }
+};
+
+struct Mesh {
+    std::string name;
+    std::vector<Primitive> primitives;
+};
+
+// A node that references a mesh. Several instances may share one mesh; each
+// gets its own light map rectangle in the `pack` layout.
+struct Instance {
+    std::string name;                // node name, or "node <index>"
+    int mesh = -1;
+    int node = -1;
+    glm::mat4 worldFromObject{1.0f};
+    float texelDensity = 0.0f;       // per-node override from extras.texelDensity (texels per scene unit); 0 = none
+};
+
+// KHR_lights_punctual "directional": a sun. `direction` is the unit world-space
+// direction the light travels (from the sun towards the scene). `irradiance`
+// is colour * intensity: the irradiance on a surface facing the sun, scene units.
+struct DirectionalLight {
+    std::string name;
+    glm::vec3 direction{0.0f, -1.0f, 0.0f};
+    glm::vec3 irradiance{1.0f};
+};
+
+struct Camera {
+    std::string name;
+    glm::mat4 worldFromCamera{1.0f};  // camera looks down its -Z, +Y up (glTF)
+    bool perspective = true;
+    float yfov = 0.8f;                // radians (perspective)
+    float aspect = 0.0f;              // 0 = use the image's
+    float znear = 0.01f;
+    float zfar = 0.0f;                // 0 = infinite
+    float xmag = 1.0f, ymag = 1.0f;   // orthographic half extents
+};
+
+struct Bounds {
+    glm::vec3 min{1e30f};
+    glm::vec3 max{-1e30f};
+    bool empty() const { return min.x > max.x; }
+    void extend(const glm::vec3& p) { min = glm::min(min, p); max = glm::max(max, p); }
+    glm::vec3 size() const { return empty() ? glm::vec3(0.0f) : max - min; }
+    glm::vec3 center() const { return (min + max) * 0.5f; }
+};
+
+// What the loader saw and skipped.
+struct LoadReport {
+    size_t skippedNonTrianglePrimitives = 0;   // points, lines, strips of lines
+    size_t skippedDegenerateTriangles = 0;     // zero world-independent area or repeated index
+    size_t primitivesWithoutMaterial = 0;
+    size_t primitivesWithoutUv1 = 0;
+};
+
+struct Scene {
+    std::string path;
+    std::vector<Mesh> meshes;
+    std::vector<Material> materials;
+    std::vector<Texture> textures;
+    std::vector<Instance> instances;
+    std::vector<DirectionalLight> lights;
+    std::vector<Camera> cameras;
+    Bounds bounds;            // world space, over all instances
+    LoadReport report;
+
+    size_t triangleCount() const;           // over instances (an instanced mesh counts each time)
+    size_t emitterTriangleCount() const;    // instanced triangles whose material emits
+    bool allHaveUv1() const;                // every instanced primitive has TEXCOORD_1
+    double instanceArea(size_t instance) const;  // world-space surface area of one instance
+};
+
+struct LoadOptions {
+    glm::vec3 defaultAlbedo{0.8f};  // for primitives without a material (glTF's default is metallic, i.e. black)
+    bool requireUv1 = false;        // fail with a hint if any primitive lacks TEXCOORD_1
+};
+
+// Loads a .gltf or .glb file. Errors (one line each, naming the file and what
+// is wrong): missing/unreadable file, parse error, NaN/Inf positions (names the
+// mesh), missing TEXCOORD_1 when requireUv1 is set, nothing to bake (no triangles).
+// Non-triangle primitives and degenerate triangles are skipped and counted in
+// Scene::report; a warning is logged for each kind.
+Expected<Scene> loadScene(const std::string& path, const LoadOptions& options = {});
+
+}  // namespace bb

@@ -1,0 +1,39 @@
+#version 430
+// Bundle pass: append one node per fragment to its pixel's linked list.
+// Outgoing radiance comes from the previous iteration: Lo = Le + albedo * L_lm,
+// resolved per texel into `radiance` (lightmap/resolve.comp).
+#include "shared/bundle_layout.h"
+#include "shared/mesh_layout.h"
+#include "lib/rounding.glsl"
+#include "lib/bundle_frame.glsl"
+
+in vec2 vLightmapUv;
+in float vDepth;
+flat in uint vPage;
+flat in uint vFlags;
+flat in vec3 vFaceNormal;
+
+layout(binding = BINDING_NODE_COUNTER) uniform atomic_uint nodeCounter;
+layout(binding = BINDING_HEADS, r32ui) uniform coherent uimage2D heads;
+layout(std430, binding = BINDING_NODES) buffer Nodes { Node nodes[]; };
+layout(binding = BINDING_RADIANCE) uniform sampler2DArray radiance;
+
+uniform uint nodeCapacity;
+uniform uint randomSeed;  // per direction and tile
+
+void main() {
+    uint index = atomicCounterIncrement(nodeCounter);
+    if (index >= nodeCapacity) return;  // overflow: the host sees counter > capacity and redraws split
+    ivec2 pixel = ivec2(gl_FragCoord.xy);
+    vec3 lo = textureLod(radiance, vec3(vLightmapUv, float(vPage)), 0.0).rgb;
+    uint h = pcgHash(randomSeed ^ pcgHash(uint(pixel.x) + 65536u * uint(pixel.y)) ^ pcgHash(uint(gl_PrimitiveID) + 0x9E3779B9u));
+    vec3 u = vec3(uniform01(h), uniform01(pcgHash(h)), uniform01(pcgHash(h + 1u)));
+    uint flags;
+    if ((vFlags & TRIANGLE_DOUBLE_SIDED) != 0u)
+        flags = NODE_VISIBLE_FROM_BEHIND | NODE_VISIBLE_FROM_AHEAD;
+    else
+        flags = dot(vFaceNormal, bundleDir) < 0.0 ? NODE_VISIBLE_FROM_BEHIND : NODE_VISIBLE_FROM_AHEAD;
+    nodes[index].radiance = encodeRgbe(lo, u);
+    nodes[index].depth = (floatBitsToUint(vDepth) & ~NODE_FLAG_MASK) | flags;
+    nodes[index].next = imageAtomicExchange(heads, pixel, index);
+}

@@ -1,0 +1,22 @@
+#version 430
+// Bundle pass: orthographic projection of the scene along d into the tile.
+#include "lib/bake_vertex.glsl"
+#include "lib/bundle_frame.glsl"
+
+out vec2 vLightmapUv;
+out float vDepth;
+flat out uint vPage;
+flat out uint vFlags;
+flat out vec3 vFaceNormal;
+
+void main() {
+    vec3 b = bundleFromWorld(inPosition.xyz);
+    vec2 ndc = (b.xy - tileOrigin) / (pixelSize * vec2(tileSize)) * 2.0 - 1.0;
+    gl_Position = vec4(ndc, 0.0, 1.0);  // no depth clipping: every fragment along the line counts
+    vLightmapUv = inLightmapUv;
+    vDepth = b.z;
+    uvec4 tri = triangles[gl_VertexID / 3];
+    vPage = tri.y;
+    vFlags = tri.w;
+    vFaceNormal = inNormal.xyz;
+}

@@ -1,0 +1,63 @@
+// GLSL twins of engine/bake/rounding.cpp: PCG hash random numbers, fp16 and
+// RGBE encodings with stochastic or nearest rounding. ROUNDING_NEAREST (a
+// define) selects the biased path kept for tests.
+
+uint pcgHash(uint v) {
+    uint state = v * 747796405u + 2891336453u;
+    uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+float uniform01(uint bits) { return float(bits >> 8u) * (1.0 / 16777216.0); }
+
+// fp16 bits of x with stochastic rounding by u in [0,1) (or nearest).
+// Saturates at 65504; NaN -> 0.
+uint floatToHalf(float x, float u) {
+    if (isnan(x)) return 0u;
+    uint sign = x < 0.0 ? 0x8000u : 0u;
+    float a = min(abs(x), 65504.0);
+    uint h = packHalf2x16(vec2(a, 0.0)) & 0x7FFFu;
+#ifndef ROUNDING_NEAREST
+    float v = unpackHalf2x16(h).x;
+    if (v != a) {
+        uint lo = v < a ? h : h - 1u;
+        uint hi = lo + 1u;
+        float vlo = unpackHalf2x16(lo).x;
+        float vhi = unpackHalf2x16(hi).x;
+        h = (u * (vhi - vlo) < a - vlo) ? hi : lo;
+        h = min(h, 0x7BFFu);
+    }
+#endif
+    return sign | h;
+}
+
+float halfToFloat(uint h) { return unpackHalf2x16(h & 0xFFFFu).x; }
+
+// RGBE: mantissas in bits 0..23, exponent byte in 24..31; value = m * 2^(e - 136).
+uint encodeRgbe(vec3 c, vec3 u) {
+    c = max(c, vec3(0.0));
+    float m = max(c.r, max(c.g, c.b));
+    if (!(m >= 1e-38)) return 0u;
+    int e;
+    frexp(m, e);  // m = f * 2^e, f in [0.5, 1)
+#ifdef ROUNDING_NEAREST
+    u = vec3(0.5);
+#endif
+    for (int attempt = 0; attempt < 2; ++attempt) {
+        vec3 scaled = c * exp2(float(8 - e));
+        uvec3 q = uvec3(floor(scaled + u));
+        if (max(q.r, max(q.g, q.b)) < 256u) {
+            int eb = clamp(e + 128, 0, 255);
+            return q.r | (q.g << 8u) | (q.b << 16u) | (uint(eb) << 24u);
+        }
+        e += 1;
+    }
+    return 0u;
+}
+
+vec3 decodeRgbe(uint v) {
+    uint eb = v >> 24u;
+    if (eb == 0u) return vec3(0.0);
+    vec3 m = vec3(float(v & 255u), float((v >> 8u) & 255u), float((v >> 16u) & 255u));
+    return m * exp2(float(int(eb) - 136));
+}

@@ -1,0 +1,36 @@
+#version 430
+// Resolve: light map L_lm = RGB / W (cosine-weighted mean of incoming
+// radiance, = E/pi; see update.frag and DESIGN.md Units) + the direct sun map. Writes, per texel of one page:
+//   RADIANCE_OUT: Lo = Le + albedo * L_lm (the next bundle passes read it)
+//   otherwise:    L_lm itself (output, preview)
+// alpha = 1 where the texel is covered by a triangle, 0 in padding (dilation fills it).
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(binding = 1, rg32ui) uniform readonly uimage2DArray accum;
+layout(binding = 2, rgba32f) uniform readonly image2DArray sunMap;
+layout(binding = 3, rgba16f) uniform readonly image2DArray albedoMap;    // a = coverage
+layout(binding = 4, rgba16f) uniform readonly image2DArray emissionMap;
+layout(binding = 5, rgba32f) uniform writeonly image2DArray target;
+
+uniform bool radianceOut;
+uniform int pageCount;
+uniform ivec2 pageSize;
+
+float h2f(uint h) { return unpackHalf2x16(h & 0xFFFFu).x; }
+
+void main() {
+    ivec3 t = ivec3(gl_GlobalInvocationID.xy, gl_GlobalInvocationID.z);
+    if (t.x >= pageSize.x || t.y >= pageSize.y || t.z >= pageCount) return;
+    vec4 albedo = imageLoad(albedoMap, t);
+    if (albedo.a <= 0.0) {
+        imageStore(target, t, vec4(0.0));
+        return;
+    }
+    uvec2 p = imageLoad(accum, t).rg;
+    float w = h2f(p.y >> 16u);
+    vec3 l = w > 0.0 ? vec3(h2f(p.x), h2f(p.x >> 16u), h2f(p.y)) / w : vec3(0.0);
+    vec4 sun = imageLoad(sunMap, t);  // rgb: sum over valid sun samples, a: their count
+    if (sun.a > 0.0) l += sun.rgb / sun.a;
+    vec3 value = radianceOut ? imageLoad(emissionMap, t).rgb + albedo.rgb * l : l;
+    imageStore(target, t, vec4(value, 1.0));
+}

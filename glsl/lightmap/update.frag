@@ -1,0 +1,129 @@
+#version 450
+// Update pass (radiance exchange, Hermes et al. 2010 as used by Tokuyoshi et
+// al. 2013): each texel projects into the tile, walks its pixel's list, takes
+// the nearest fragment in front of it on the side its normal faces, and adds
+// L_in * |cos| to RGB and |cos| to W (both scaled by the direction's weight).
+// L_lm = RGB / W: a cosine-weighted mean of L_in, which equals E/pi. With
+// uniform directions E[W] = N/2, so this is DESIGN.md's 2 RGB / N, but it
+// stays unbiased when invalid samples (below) are skipped, since those are
+// mostly grazing ones: dividing by the count would overweight steep ones.
+//
+// SUN_PASS (define): the same walk along the sun's direction; a texel facing
+// the sun adds (nothing in front ? irradiance * cos / pi : 0) to the direct
+// sun map's rgb and 1 to its alpha (exact shadow test, no noise).
+#include "shared/bundle_layout.h"
+#include "lib/rounding.glsl"
+#include "lib/bundle_frame.glsl"
+
+in vec3 vPosition;
+in vec3 vNormal;
+flat in uint vFlags;
+
+layout(binding = BINDING_HEADS, r32ui) uniform readonly uimage2D heads;
+layout(std430, binding = BINDING_NODES) readonly buffer Nodes { Node nodes[]; };
+#ifdef SUN_PASS
+layout(binding = BINDING_SUN, rgba32f) uniform coherent image2DArray sunMap;
+uniform vec3 sunIrradiance;
+#else
+layout(binding = BINDING_ACCUM, rg32ui) uniform coherent uimage2DArray accum;
+layout(binding = BINDING_ENV) uniform sampler2D envMap;
+uniform bool useEnv;
+uniform vec3 sky;
+uniform float sampleWeight;  // this direction's weight (history ramp), relative to the stored scale
+uniform uint randomSeed;
+#endif
+uniform int page;
+uniform uint nodeCount;      // nodes in this tile's lists (END_OF_LIST is larger)
+uniform float depthBias;      // scene units: float precision floor
+
+const float PI = 3.14159265358979;
+
+vec3 environment(vec3 dir) {
+#ifndef SUN_PASS
+    if (useEnv) {
+        // equirectangular, +Y up, u = 0 at -X going through +Z (glTF-style)
+        float phi = atan(dir.z, dir.x);
+        float theta = acos(clamp(dir.y, -1.0, 1.0));
+        return textureLod(envMap, vec2(0.5 + phi / (2.0 * PI), theta / PI), 0.0).rgb;
+    }
+    return sky;
+#else
+    return vec3(0.0);
+#endif
+}
+
+void main() {
+    // llvmpipe runs helper lanes through the walk with undefined loads, where they
+    // spin; they have no side effects to make, so leave at once (GLSL 4.50).
+    if (gl_HelperInvocation) return;
+    vec3 n = normalize(vNormal);
+    vec3 b = bundleFromWorld(vPosition);
+    ivec2 pixel = ivec2(floor((b.xy - tileOrigin) / pixelSize));
+    if (any(lessThan(pixel, ivec2(0))) || any(greaterThanEqual(pixel, tileSize))) return;  // another tile's
+
+    float c = dot(n, bundleDir);
+    bool ahead = c > 0.0;  // the texel looks along +d
+    uint ownSide = ahead ? NODE_VISIBLE_FROM_AHEAD : NODE_VISIBLE_FROM_BEHIND;
+    uint seenSide = ahead ? NODE_VISIBLE_FROM_BEHIND : NODE_VISIBLE_FROM_AHEAD;
+    // The ray through the pixel centre passes up to half a pixel diagonal
+    // beside the texel; the texel's own surface crosses it within
+    // offset * tan(theta) in depth. Find that crossing (a fragment facing the
+    // texel's side): the ray then starts exactly on the surface. If there is
+    // none, the ray runs beside the surface (past a wall's edge, outside a
+    // closed mesh) and would see what the texel cannot: the sample is
+    // invalid and skipped (W unchanged), as Unity's backface validity does.
+    float tanTheta = min(sqrt(max(1.0 - c * c, 0.0)) / max(abs(c), 1e-4), 8.0);
+    float eps = pixelSize * (0.7072 * tanTheta + 0.05) + depthBias;
+    float self = 0.0;
+    float selfDistance = 3.0e38;
+    // `i < nodeCount` rather than `!= END_OF_LIST`: ends on any stray index too
+    for (uint i = imageLoad(heads, pixel).r; i < nodeCount; i = nodes[i].next) {
+        float z = uintBitsToFloat(nodes[i].depth);
+        float dz = abs(z - b.z);
+        if (dz <= eps && (nodes[i].depth & ownSide) != 0u && dz < selfDistance) {
+            selfDistance = dz;
+            self = z;
+        }
+    }
+    if (selfDistance > eps) return;
+    float start = self + (ahead ? depthBias : -depthBias);
+
+    float best = ahead ? 3.0e38 : -3.0e38;
+    uint bestNode = END_OF_LIST;
+    for (uint i = imageLoad(heads, pixel).r; i < nodeCount; i = nodes[i].next) {
+        float z = uintBitsToFloat(nodes[i].depth);
+        bool inFront = ahead ? (z > start && (z < best || (z == best && nodes[i].radiance > nodes[bestNode].radiance)))
+                             : (z < start && (z > best || (z == best && nodes[i].radiance > nodes[bestNode].radiance)));
+        if (inFront) {
+            best = z;
+            bestNode = i;
+        }
+    }
+    ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), page);
+
+#ifdef SUN_PASS
+    // the sun pass's d is the light's travel direction: a texel facing the sun looks along -d
+    // a valid sample: rgb += lit irradiance * cos / pi, a += 1 (resolve divides)
+    if (ahead) return;
+    vec4 s = imageLoad(sunMap, texel);
+    vec3 lit = bestNode == END_OF_LIST ? sunIrradiance * (-c) / PI : vec3(0.0);
+    imageStore(sunMap, texel, vec4(s.rgb + lit, s.a + 1.0));
+#else
+    vec3 incoming;
+    if (bestNode == END_OF_LIST) {
+        incoming = environment(ahead ? bundleDir : -bundleDir);
+    } else {
+        bool visible = (nodes[bestNode].depth & seenSide) != 0u;
+        incoming = visible ? decodeRgbe(nodes[bestNode].radiance) : vec3(0.0);  // a back face is black
+    }
+    uvec2 stored = imageLoad(accum, texel).rg;
+    vec4 sum = vec4(halfToFloat(stored.x), halfToFloat(stored.x >> 16u), halfToFloat(stored.y),
+                    halfToFloat(stored.y >> 16u));
+    sum += sampleWeight * abs(c) * vec4(incoming, 1.0);
+    uint h = pcgHash(randomSeed ^ pcgHash(uint(texel.x) | (uint(texel.y) << 16u)) ^ pcgHash(uint(page) + 7919u));
+    uint h1 = pcgHash(h), h2 = pcgHash(h1), h3 = pcgHash(h2);
+    uvec2 result = uvec2(floatToHalf(sum.r, uniform01(h)) | (floatToHalf(sum.g, uniform01(h1)) << 16u),
+                         floatToHalf(sum.b, uniform01(h2)) | (floatToHalf(sum.a, uniform01(h3)) << 16u));
+    imageStore(accum, texel, uvec4(result, 0u, 0u));
+#endif
+}

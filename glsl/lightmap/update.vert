@@ -1,0 +1,15 @@
+#version 430
+// Update pass: raster in light map space (one fragment per covered texel
+// centre) carrying the texel's world position and normal.
+#include "lib/bake_vertex.glsl"
+
+out vec3 vPosition;
+out vec3 vNormal;
+flat out uint vFlags;
+
+void main() {
+    gl_Position = vec4(inLightmapUv * 2.0 - 1.0, 0.0, 1.0);
+    vPosition = inPosition.xyz;
+    vNormal = inNormal.xyz;
+    vFlags = triangles[gl_VertexID / 3].w;
+}

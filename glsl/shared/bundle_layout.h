@@ -1,0 +1,40 @@
+// Buffer layouts and binding points shared by C++ and GLSL (std430 only, no
+// vec3 members). Included by engine/bake/*.cpp and by the shaders.
+#ifndef BUNDLEBAKE_BUNDLE_LAYOUT_H
+#define BUNDLEBAKE_BUNDLE_LAYOUT_H
+
+#ifdef __cplusplus
+#include <cstdint>
+namespace bb::shared {
+using uint = uint32_t;
+#endif
+
+// One fragment of a ray bundle: 12 bytes.
+struct Node {
+    uint radiance;  // outgoing radiance Lo, RGBE (see glsl/lib/rounding.glsl)
+    uint depth;     // floatBitsToUint(depth along d); its 2 low mantissa bits are NODE_VISIBLE_* flags
+    uint next;      // index of the next node in this pixel's list, or END_OF_LIST
+};
+
+#define END_OF_LIST 0xFFFFFFFFu
+// Which side of the surface the radiance leaves from (front faces, or both for double-sided):
+#define NODE_VISIBLE_FROM_BEHIND 1u   // seen by texels looking along +d (surface front faces -d)
+#define NODE_VISIBLE_FROM_AHEAD 2u    // seen by texels looking along -d (surface front faces +d)
+#define NODE_FLAG_MASK 3u
+
+// Bindings
+#define BINDING_NODES 0          // SSBO: Node nodes[]
+#define BINDING_NODE_COUNTER 0   // atomic counter: nodes appended
+#define BINDING_HEADS 0          // image unit: r32ui head pointers of the tile
+#define BINDING_ACCUM 1          // image unit: rg32ui accumulators (packed fp16 RGB + W), array of pages
+#define BINDING_SUN 2            // image unit: rgba32f direct sun L_lm, array of pages
+#define BINDING_RADIANCE 0       // texture unit: rgba16f outgoing radiance Lo per texel, array of pages
+#define BINDING_ENV 1            // texture unit: environment map (equirectangular)
+#define BINDING_MATERIAL_TEX 2   // texture unit: a material's albedo / emission texture
+
+#ifdef __cplusplus
+}  // namespace bb::shared
+static_assert(sizeof(bb::shared::Node) == 12, "a node is 12 bytes");
+#endif
+
+#endif

@@ -1,0 +1,101 @@
+// `bundlebake bake`: load, lay out, bake on a headless context, write
+// EXR pages + manifest.json + stats.json + tone-mapped PNG previews.
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+
+#include "bake/baker.h"
+#include "core/log.h"
+#include "headless/cli/options.h"
+#include "bake/bake_output.h"
+#include "headless/cli/progress.h"
+#include "headless/platform.h"
+
+namespace bb::cli {
+
+void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
+    addSceneOptions(cmd, a.scene);
+    cmd.add_option("-o,--output", a.outDir, "Output directory (created if missing)")->required();
+    cmd.add_option("--backend", a.backend, "Headless GL: egl (surfaceless) or osmesa")
+        ->check(CLI::IsMember({"egl", "osmesa"}))
+        ->capture_default_str();
+    cmd.add_option("--directions", a.directions, "Bundle directions (each serves d and -d)")
+        ->check(CLI::Range(1, 1 << 20))
+        ->capture_default_str();
+    cmd.add_option("--bundle-res", a.bundleRes,
+                   "Uniform bundle resolution in pixels across the scene's bounding sphere (0 = half a light map texel per pixel)")
+        ->check(CLI::Range(0, 1 << 20))
+        ->capture_default_str();
+    cmd.add_option("--memory-budget", a.memoryBudget, "GPU bytes for one tile's node buffer and head image (e.g. 512M, 2G)")
+        ->capture_default_str();
+    cmd.add_option("--seed", a.seed, "Random seed (directions, stochastic rounding)")->capture_default_str();
+    cmd.add_option("--sky", a.sky, "Uniform sky radiance r,g,b (scene units)")->capture_default_str();
+    cmd.add_option("--env", a.env, "Equirectangular environment map (EXR/HDR), radiance; replaces --sky")
+        ->excludes(cmd.get_option("--sky"));
+    cmd.add_option("--rounding", a.rounding, "fp16/RGBE conversion: stochastic (unbiased) or nearest (biased, for tests)")
+        ->check(CLI::IsMember({"stochastic", "nearest"}))
+        ->capture_default_str();
+    cmd.add_option("--history-power", a.historyPower,
+                   "Weight direction k by min(k, N/2)^p to fade early, few-bounce directions (-1 = from the largest albedo)")
+        ->capture_default_str();
+    cmd.add_flag("--no-preview", [&a](int64_t) { a.preview = false; }, "Do not write PNG previews");
+    cmd.add_flag("--no-progress", [&a](int64_t) { a.progress = false; }, "No progress bar on stderr");
+}
+
+int runBake(const BakeArgs& args) {
+    auto backend = parseBackend(args.backend);
+    if (!backend) return fail(backend.error());
+    auto budget = parseSize(args.memoryBudget, "--memory-budget");
+    if (!budget) return fail(budget.error());
+    auto sky = parseColor(args.sky, "--sky");
+    if (!sky) return fail(sky.error());
+    BakeOptions options;
+    options.directions = args.directions;
+    options.bundleResolution = args.bundleRes;
+    options.memoryBudget = *budget;
+    options.seed = args.seed;
+    options.sky = *sky;
+    options.rounding = args.rounding == "nearest" ? Rounding::Nearest : Rounding::Stochastic;
+    options.historyPower = args.historyPower;
+    if (!args.env.empty()) {
+        auto env = io::readImageRgb(args.env);
+        if (!env) return fail(env.error());
+        options.environment = std::move(env.value());
+    }
+    auto loaded = loadSceneAndLayout(args.scene);
+    if (!loaded) return fail(loaded.error());
+    if (Status s = io::ensureDirectory(args.outDir); !s) return fail(s.message());
+
+    auto context = createHeadlessContext(*backend);
+    if (!context) return fail(context.error());
+    auto baker = Baker::create(loaded->scene, loaded->layout, options);
+    if (!baker) return fail(baker.error());
+
+    ProgressBar bar(args.progress && isatty(STDERR_FILENO));
+    auto t0 = std::chrono::steady_clock::now();
+    while (true) {
+        BakeProgress p = (*baker)->step(0.25);
+        bar.update(p.directionsDone, p.directionsTotal);
+        if (p.done()) break;
+    }
+    bar.finish();
+    double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+    BakeOutputInfo info;
+    info.backend = backendName(*backend);
+    info.renderer = context.value()->caps().renderer;
+    info.settings = {{"directions", args.directions}, {"bundle_res", args.bundleRes}, {"memory_budget", args.memoryBudget},
+                     {"seed", args.seed}, {"sky", args.sky}, {"env", args.env}, {"rounding", args.rounding},
+                     {"uv_layout", args.scene.uvLayout}, {"resolution", args.scene.resolution},
+                     {"texel_density", args.scene.texelDensity}, {"history_power", (*baker)->stats().historyPower}};
+    info.wallSeconds = seconds;
+    info.writePreviews = args.preview;
+    if (Status s = writeBakeOutputs(args.outDir, loaded->scene, loaded->layout, **baker, info); !s) return fail(s.message());
+    logInfo("baked " + std::to_string(options.directions) + " directions in " + std::to_string(seconds) + " s -> " +
+            args.outDir);
+    return 0;
+}
+
+}  // namespace bb::cli

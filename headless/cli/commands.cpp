@@ -1,0 +1,41 @@
+#include "headless/cli/commands.h"
+
+#include <cstdio>
+
+#include <CLI/CLI.hpp>
+
+#include "core/log.h"
+#include "headless/cli/options.h"
+
+namespace bb::cli {
+
+int run(int argc, char** argv) {
+    CLI::App app{"bundlebake: diffuse global illumination into light maps by ray-bundle tracing on OpenGL 4.3"};
+    app.require_subcommand(1);
+    app.set_help_all_flag("--help-all", "Show help for every command");
+    bool verbose = false, quiet = false;
+    app.add_flag("-v,--verbose", verbose, "Log debug messages");
+    app.add_flag("-q,--quiet", quiet, "Only log errors");
+
+    InfoArgs info;
+    CLI::App* infoCmd = app.add_subcommand("info", "Describe a scene: triangles, instances, materials, emitters, lights, bounds, light map texels and pages");
+    addInfoOptions(*infoCmd, info);
+
+    BakeArgs bake;
+    CLI::App* bakeCmd = app.add_subcommand("bake", "Bake light maps (EXR pages, manifest.json, stats.json, preview PNG)");
+    addBakeOptions(*bakeCmd, bake);
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        if (e.get_exit_code() == 0) return app.exit(e);
+        std::fprintf(stderr, "bundlebake: error: %s (see --help)\n", e.what());
+        return 2;
+    }
+    setLogLevel(quiet ? LogLevel::Error : verbose ? LogLevel::Debug : LogLevel::Info);
+    if (infoCmd->parsed()) return runInfo(info);
+    if (bakeCmd->parsed()) return runBake(bake);
+    return 2;
+}
+
+}  // namespace bb::cli

@@ -1,0 +1,123 @@
+#include "headless/cli/options.h"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "core/log.h"
+
+namespace bb::cli {
+
+int fail(const std::string& message) {
+    std::fprintf(stderr, "bundlebake: error: %s\n", message.c_str());
+    return 1;
+}
+
+void addSceneOptions(CLI::App& cmd, SceneArgs& a) {
+    cmd.add_option("scene", a.scene, "glTF 2.0 scene (.gltf or .glb)")->required();
+    cmd.add_option("--uv-layout", a.uvLayout, "Light map layout: pack (a rectangle per instance) or asset (TEXCOORD_1 as one atlas)")
+        ->check(CLI::IsMember({"pack", "asset"}))
+        ->capture_default_str();
+    cmd.add_option("--resolution", a.resolution, "Light map page size in texels (square)")
+        ->check(CLI::Range(16, 16384))
+        ->capture_default_str();
+    cmd.add_option("--texel-density", a.texelDensity,
+                   "Texels per scene unit for the pack layout (0 = fit the scene into about one page)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    cmd.add_option("--default-albedo", a.defaultAlbedo, "Diffuse albedo for primitives without a material (r,g,b)")
+        ->capture_default_str();
+}
+
+void addInfoOptions(CLI::App& cmd, InfoArgs& a) { addSceneOptions(cmd, a.scene); }
+
+Expected<glm::vec3> parseColor(const std::string& text, const char* flag) {
+    std::vector<float> v;
+    std::stringstream ss(text);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        try {
+            size_t used = 0;
+            float f = std::stof(item, &used);
+            if (used != item.size() || !std::isfinite(f) || f < 0) throw std::invalid_argument("");
+            v.push_back(f);
+        } catch (...) {
+            return Expected<glm::vec3>::failure(std::string(flag) + ": '" + text +
+                                                "' is not a colour (expected r,g,b with finite values >= 0)");
+        }
+    }
+    if (v.size() == 1) return glm::vec3(v[0]);
+    if (v.size() != 3)
+        return Expected<glm::vec3>::failure(std::string(flag) + ": '" + text + "' is not a colour (expected r,g,b)");
+    return glm::vec3(v[0], v[1], v[2]);
+}
+
+Expected<int64_t> parseSize(const std::string& text, const char* flag) {
+    char* end = nullptr;
+    double v = std::strtod(text.c_str(), &end);
+    std::string suffix = end ? std::string(end) : "";
+    double mult = 1;
+    if (suffix == "K" || suffix == "k" || suffix == "KiB") mult = 1024.0;
+    else if (suffix == "M" || suffix == "m" || suffix == "MiB") mult = 1024.0 * 1024;
+    else if (suffix == "G" || suffix == "g" || suffix == "GiB") mult = 1024.0 * 1024 * 1024;
+    else if (!suffix.empty() || end == text.c_str())
+        return Expected<int64_t>::failure(std::string(flag) + ": '" + text + "' is not a size (e.g. 512M, 2G)");
+    if (!(v > 0) || !std::isfinite(v))
+        return Expected<int64_t>::failure(std::string(flag) + ": '" + text + "' must be positive");
+    return int64_t(v * mult);
+}
+
+Expected<LoadedScene> loadSceneAndLayout(const SceneArgs& a) {
+    auto albedo = parseColor(a.defaultAlbedo, "--default-albedo");
+    if (!albedo) return albedo.status();
+    LoadOptions lo;
+    lo.defaultAlbedo = *albedo;
+    auto scene = loadScene(a.scene, lo);
+    if (!scene) return scene.status();
+    LayoutOptions opts;
+    opts.mode = a.uvLayout == "asset" ? UvLayout::Asset : UvLayout::Pack;
+    opts.resolution = a.resolution;
+    opts.texelDensity = a.texelDensity;
+    auto layout = computeLayout(*scene, opts);
+    if (!layout) return Expected<LoadedScene>::failure(a.scene + ": " + layout.error());
+    return LoadedScene{std::move(scene.value()), std::move(layout.value())};
+}
+
+int runInfo(const InfoArgs& args) {
+    auto loaded = loadSceneAndLayout(args.scene);
+    if (!loaded) return fail(loaded.error());
+    const Scene& s = loaded->scene;
+    const Layout& l = loaded->layout;
+    size_t emissiveMaterials = 0;
+    for (const auto& m : s.materials)
+        if (m.emission.r > 0 || m.emission.g > 0 || m.emission.b > 0) ++emissiveMaterials;
+    size_t coveredTexels = 0;
+    for (const auto& r : l.rects) coveredTexels += size_t(r.width) * r.height;
+    if (l.mode == UvLayout::Asset) coveredTexels = l.texelCount();
+    glm::vec3 size = s.bounds.size();
+    std::printf("scene        %s\n", s.path.c_str());
+    std::printf("triangles    %zu (in %zu instances of %zu meshes)\n", s.triangleCount(), s.instances.size(), s.meshes.size());
+    std::printf("skipped      %zu degenerate triangles, %zu non-triangle primitives\n",
+                s.report.skippedDegenerateTriangles, s.report.skippedNonTrianglePrimitives);
+    std::printf("materials    %zu (%zu emissive, %zu primitives use the default albedo)\n", s.materials.size(),
+                emissiveMaterials, s.report.primitivesWithoutMaterial);
+    std::printf("emitters     %zu emissive triangles\n", s.emitterTriangleCount());
+    std::printf("lights       %zu directional\n", s.lights.size());
+    for (const auto& light : s.lights)
+        std::printf("             %s: direction (%.3f, %.3f, %.3f), irradiance (%.3g, %.3g, %.3g)\n", light.name.c_str(),
+                    light.direction.x, light.direction.y, light.direction.z, light.irradiance.r, light.irradiance.g,
+                    light.irradiance.b);
+    std::printf("cameras      %zu\n", s.cameras.size());
+    std::printf("textures     %zu\n", s.textures.size());
+    std::printf("bounds       min (%.4g, %.4g, %.4g) max (%.4g, %.4g, %.4g) size (%.4g, %.4g, %.4g) scene units\n",
+                s.bounds.min.x, s.bounds.min.y, s.bounds.min.z, s.bounds.max.x, s.bounds.max.y, s.bounds.max.z, size.x,
+                size.y, size.z);
+    std::printf("uv1          %s\n", s.allHaveUv1() ? "present on every primitive" : "missing on some primitives");
+    std::printf("layout       %s, %d page(s) of %dx%d texels, padding %d\n", l.mode == UvLayout::Asset ? "asset" : "pack",
+                l.pageCount, l.resolution, l.resolution, l.padding);
+    if (l.mode == UvLayout::Pack) std::printf("density      %.6g texels per scene unit\n", l.texelDensity);
+    std::printf("texels       %zu in pages, %zu inside instance rectangles\n", l.texelCount(), coveredTexels);
+    return 0;
+}
+
+}  // namespace bb::cli

@@ -1,0 +1,68 @@
+// Flags shared by the commands, and the commands themselves.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <glm/glm.hpp>
+
+#include "core/status.h"
+#include "layout/layout.h"
+#include "scene/scene.h"
+
+namespace bb::cli {
+
+struct SceneArgs {
+    std::string scene;
+    std::string uvLayout = "pack";
+    int resolution = 512;
+    float texelDensity = 0.0f;
+    std::string defaultAlbedo = "0.8,0.8,0.8";
+};
+
+struct InfoArgs {
+    SceneArgs scene;
+};
+
+struct BakeArgs {
+    SceneArgs scene;
+    std::string outDir;
+    std::string backend = "egl";
+    int directions = 256;
+    int bundleRes = 0;                // 0 = from the layout's texel density
+    std::string memoryBudget = "512M";
+    uint64_t seed = 1;
+    std::string sky = "0,0,0";
+    std::string env;
+    int checkpointEvery = 0;
+    bool resume = false;
+    std::string rounding = "stochastic";
+    float historyPower = -1.0f;
+    bool preview = true;
+    bool progress = true;
+};
+
+void addSceneOptions(CLI::App& cmd, SceneArgs& args);
+void addInfoOptions(CLI::App& cmd, InfoArgs& args);
+void addBakeOptions(CLI::App& cmd, BakeArgs& args);
+
+// Parses "r,g,b" (three finite numbers >= 0) or a single number for grey.
+Expected<glm::vec3> parseColor(const std::string& text, const char* flag);
+// Parses "512M", "2G", "300000K", "1048576" (bytes).
+Expected<int64_t> parseSize(const std::string& text, const char* flag);
+
+// Loads the scene and computes the layout from SceneArgs; errors are one line.
+struct LoadedScene {
+    Scene scene;
+    Layout layout;
+};
+Expected<LoadedScene> loadSceneAndLayout(const SceneArgs& args);
+
+int runInfo(const InfoArgs& args);
+int runBake(const BakeArgs& args);
+
+// Prints "bundlebake: error: <message>" to stderr and returns 1.
+int fail(const std::string& message);
+
+}  // namespace bb::cli
