@@ -44,6 +44,13 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
     cmd.add_flag("--no-progress", [&a](int64_t) { a.progress = false; }, "No progress bar on stderr");
 }
 
+void addBakeCommand(CLI::App& app, std::function<int()>& action) {
+    auto args = std::make_shared<BakeArgs>();
+    CLI::App* cmd = app.add_subcommand("bake", "Bake light maps (EXR pages, manifest.json, stats.json, PNG previews)");
+    addBakeOptions(*cmd, *args);
+    cmd->callback([args, &action] { action = [args] { return runBake(*args); }; });
+}
+
 int runBake(const BakeArgs& args) {
     auto backend = parseBackend(args.backend);
     if (!backend) return fail(backend.error());

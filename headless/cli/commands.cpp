@@ -1,6 +1,7 @@
 #include "headless/cli/commands.h"
 
 #include <cstdio>
+#include <functional>
 
 #include <CLI/CLI.hpp>
 
@@ -17,13 +18,10 @@ int run(int argc, char** argv) {
     app.add_flag("-v,--verbose", verbose, "Log debug messages");
     app.add_flag("-q,--quiet", quiet, "Only log errors");
 
-    InfoArgs info;
-    CLI::App* infoCmd = app.add_subcommand("info", "Describe a scene: triangles, instances, materials, emitters, lights, bounds, light map texels and pages");
-    addInfoOptions(*infoCmd, info);
-
-    BakeArgs bake;
-    CLI::App* bakeCmd = app.add_subcommand("bake", "Bake light maps (EXR pages, manifest.json, stats.json, preview PNG)");
-    addBakeOptions(*bakeCmd, bake);
+    // Each command registers its subcommand and sets `action` when parsed.
+    std::function<int()> action;
+    addInfoCommand(app, action);
+    addBakeCommand(app, action);
 
     try {
         app.parse(argc, argv);
@@ -33,9 +31,7 @@ int run(int argc, char** argv) {
         return 2;
     }
     setLogLevel(quiet ? LogLevel::Error : verbose ? LogLevel::Debug : LogLevel::Info);
-    if (infoCmd->parsed()) return runInfo(info);
-    if (bakeCmd->parsed()) return runBake(bake);
-    return 2;
+    return action ? action() : 2;
 }
 
 }  // namespace bb::cli

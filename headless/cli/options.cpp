@@ -29,7 +29,13 @@ void addSceneOptions(CLI::App& cmd, SceneArgs& a) {
         ->capture_default_str();
 }
 
-void addInfoOptions(CLI::App& cmd, InfoArgs& a) { addSceneOptions(cmd, a.scene); }
+void addInfoCommand(CLI::App& app, std::function<int()>& action) {
+    auto args = std::make_shared<InfoArgs>();
+    CLI::App* cmd = app.add_subcommand(
+        "info", "Describe a scene: triangles, instances, materials, emitters, lights, bounds, light map texels and pages");
+    addSceneOptions(*cmd, args->scene);
+    cmd->callback([args, &action] { action = [args] { return runInfo(*args); }; });
+}
 
 Expected<glm::vec3> parseColor(const std::string& text, const char* flag) {
     std::vector<float> v;

@@ -2,6 +2,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -44,7 +46,6 @@ struct BakeArgs {
 };
 
 void addSceneOptions(CLI::App& cmd, SceneArgs& args);
-void addInfoOptions(CLI::App& cmd, InfoArgs& args);
 void addBakeOptions(CLI::App& cmd, BakeArgs& args);
 
 // Parses "r,g,b" (three finite numbers >= 0) or a single number for grey.
@@ -58,6 +59,11 @@ struct LoadedScene {
     Layout layout;
 };
 Expected<LoadedScene> loadSceneAndLayout(const SceneArgs& args);
+
+// Command registration: adds the subcommand to `app`; when it is parsed, its
+// callback stores the command's run function into `action`.
+void addInfoCommand(CLI::App& app, std::function<int()>& action);
+void addBakeCommand(CLI::App& app, std::function<int()>& action);
 
 int runInfo(const InfoArgs& args);
 int runBake(const BakeArgs& args);
