@@ -1,0 +1,30 @@
+#!/bin/sh
+# Installs the Debian 12 packages bundlebake builds, tests and benches with.
+# Idempotent and non-interactive; run as root. Only calls apt-get when
+# something is missing, so a second run costs a dpkg query.
+set -eu
+
+PACKAGES="
+g++ cmake make pkg-config python3 python3-glad
+libegl-dev libegl-mesa0 libgl1-mesa-dri libgl-dev libosmesa6-dev
+libglm-dev libopenimageio-dev libimath-dev libtinygltf-dev libstb-dev
+nlohmann-json3-dev libcli11-dev libgtest-dev libembree-dev
+libglfw3-dev libimgui-dev xvfb xauth python3-matplotlib
+"
+
+missing=""
+for p in $PACKAGES; do
+    if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+        missing="$missing $p"
+    fi
+done
+
+if [ -n "$missing" ]; then
+    echo "install-deps: installing:$missing"
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -q
+    # shellcheck disable=SC2086
+    apt-get install -y -q --no-install-recommends $missing
+else
+    echo "install-deps: all packages present"
+fi
