@@ -27,6 +27,37 @@ struct TileRect {
 };
 
 
+// Per texel of every page, the covered texel whose value it shows: itself if
+// covered, else the nearest covered texel within `radius` texels (Chebyshev
+// rings, Euclidean nearest, ties to the lowest index), else -1. Packed x | y << 16.
+std::vector<int32_t> dilationSources(const std::vector<uint8_t>& covered, int res, int pages, int radius) {
+    std::vector<int32_t> source(covered.size(), -1);
+    for (int p = 0; p < pages; ++p) {
+        const size_t base = size_t(p) * res * res;
+        for (int y = 0; y < res; ++y)
+            for (int x = 0; x < res; ++x) {
+                if (covered[base + size_t(y) * res + x]) {
+                    source[base + size_t(y) * res + x] = x | (y << 16);
+                    continue;
+                }
+                int best = -1, bestD2 = 1 << 30;
+                for (int dy = -radius; dy <= radius; ++dy)
+                    for (int dx = -radius; dx <= radius; ++dx) {
+                        int qx = x + dx, qy = y + dy;
+                        if (qx < 0 || qy < 0 || qx >= res || qy >= res) continue;
+                        if (!covered[base + size_t(qy) * res + qx]) continue;
+                        int d2 = dx * dx + dy * dy;
+                        if (d2 < bestD2) {
+                            bestD2 = d2;
+                            best = qx | (qy << 16);
+                        }
+                    }
+                source[base + size_t(y) * res + x] = best;
+            }
+    }
+    return source;
+}
+
 }  // namespace
 
 struct Baker::Impl {
@@ -53,9 +84,9 @@ struct Baker::Impl {
     // GL objects
     gl::Buffer vertexBuffer, triangleBuffer, metaIndexBuffer, nodeBuffer, counterBuffer;
     gl::VertexArray vao;
-    gl::Texture albedoMap, emissionMap, accum, sunMap, radiance, scratch, heads, envTexture;
+    gl::Texture albedoMap, emissionMap, accum, sunMap, radiance, resolved, heads, envTexture, dilationSource;
     gl::Framebuffer bundleFbo, pageFbo, metaFbo;
-    gl::Program appendProgram, updateProgram, sunProgram, resolveProgram, dilateProgram, rescaleProgram, metaProgram;
+    gl::Program appendProgram, updateProgram, sunProgram, resolveProgram, rescaleProgram, metaProgram;
     std::vector<gl::Texture> materialTextures;
     int64_t nodeCapacity = 0;
 
@@ -72,7 +103,6 @@ struct Baker::Impl {
     void setFrameUniforms(GLuint program, const glm::vec3& d, const glm::vec3& u, const glm::vec3& v,
                           glm::vec2 origin, const TileRect& tile);
     void resolveInto(bool radianceOut, gl::Texture& target);
-    gl::Texture* dilate(gl::Texture& first, gl::Texture& second, int passes);
     void dispatchPages(GLuint program);
     double predictNodes(const glm::vec3& d) const;
 };
@@ -116,7 +146,6 @@ Status Baker::Impl::buildPrograms() {
         {&updateProgram, {"lightmap/update.vert", "lightmap/update.frag"}, rounding},
         {&sunProgram, {"lightmap/update.vert", "lightmap/update.frag"}, "#define SUN_PASS 1\n"},
         {&resolveProgram, {"lightmap/resolve.comp"}, ""},
-        {&dilateProgram, {"lightmap/dilate.comp"}, ""},
         {&rescaleProgram, {"lightmap/rescale.comp"}, rounding},
         {&metaProgram, {"lightmap/meta.vert", "lightmap/meta.frag"}, ""},
     };
@@ -307,11 +336,9 @@ Status Baker::Impl::init(const Scene& scene) {
     accum = gl::Texture::create2DArray("accumulators (fp16 RGB+W)", GL_RG32UI, res, res, pages);
     sunMap = gl::Texture::create2DArray("direct sun map", GL_RGBA32F, res, res, pages);
     radiance = gl::Texture::create2DArray("outgoing radiance map", GL_RGBA32F, res, res, pages);
-    scratch = gl::Texture::create2DArray("dilation scratch", GL_RGBA32F, res, res, pages);
+    resolved = gl::Texture::create2DArray("resolved light map", GL_RGBA32F, res, res, pages);
     glTextureParameteri(radiance.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     glTextureParameteri(radiance.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTextureParameteri(scratch.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTextureParameteri(scratch.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     const uint32_t zeroU[4] = {0, 0, 0, 0};
     const float zeroF[4] = {0, 0, 0, 0};
     glClearTexImage(accum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, zeroU);
@@ -350,7 +377,14 @@ Status Baker::Impl::init(const Scene& scene) {
     std::vector<glm::u16vec4> texels(size_t(res) * res * pages);
     glGetTextureImage(albedoMap.id(), 0, GL_RGBA, GL_HALF_FLOAT, GLsizei(texels.size() * 8), texels.data());
     stats.lightmapTexels = int64_t(texels.size());
-    for (const auto& t : texels) stats.coveredTexels += t.w != 0;
+    std::vector<uint8_t> covered(texels.size());
+    for (size_t i = 0; i < texels.size(); ++i) {
+        covered[i] = texels[i].w != 0;
+        stats.coveredTexels += covered[i];
+    }
+    std::vector<int32_t> source = dilationSources(covered, res, pages, std::max(layout.padding, 1) + 1);
+    dilationSource = gl::Texture::create2DArray("dilation source texels", GL_R32I, res, res, pages);
+    glTextureSubImage3D(dilationSource.id(), 0, 0, 0, 0, res, res, pages, GL_RED_INTEGER, GL_INT, source.data());
     stats.secondsSetup = secondsSince(t0);
 
     auto ts = Clock::now();
@@ -546,7 +580,6 @@ void Baker::Impl::bakeDirection(int k) {
 
 void Baker::Impl::resolveInto(bool radianceOut, gl::Texture& target) {
     gl::DebugGroup group("resolve");
-    gl::Texture& other = (&target == &radiance) ? scratch : radiance;
     glUseProgram(resolveProgram.id());
     glUniform1i(resolveProgram.uniform("radianceOut"), radianceOut);
     glBindImageTexture(1, accum.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RG32UI);
@@ -554,24 +587,8 @@ void Baker::Impl::resolveInto(bool radianceOut, gl::Texture& target) {
     glBindImageTexture(3, albedoMap.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
     glBindImageTexture(4, emissionMap.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
     glBindImageTexture(5, target.id(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(6, dilationSource.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_R32I);
     dispatchPages(resolveProgram.id());
-    // an even number of passes ends in `target`
-    int passes = 2 * ((std::max(layout.padding, 1) + 2) / 2);
-    gl::Texture* result = dilate(target, other, passes);
-    CHECK(result == &target);
-}
-
-gl::Texture* Baker::Impl::dilate(gl::Texture& first, gl::Texture& second, int passes) {
-    glUseProgram(dilateProgram.id());
-    gl::Texture* src = &first;
-    gl::Texture* dst = &second;
-    for (int i = 0; i < passes; ++i) {
-        glBindImageTexture(5, src->id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
-        glBindImageTexture(6, dst->id(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-        dispatchPages(dilateProgram.id());
-        std::swap(src, dst);
-    }
-    return src;
 }
 
 Baker::Baker(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -602,14 +619,12 @@ BakeProgress Baker::progress() const { return {impl_->stats.directionsDone, impl
 
 LightmapPages Baker::readLightmaps() {
     Impl& m = *impl_;
-    m.resolveInto(false, m.scratch);
+    m.resolveInto(false, m.resolved);
     const int res = m.layout.resolution;
     std::vector<glm::vec4> texels(size_t(res) * res * m.layout.pageCount);
-    glGetTextureImage(m.scratch.id(), 0, GL_RGBA, GL_FLOAT, GLsizei(texels.size() * 16), texels.data());
+    glGetTextureImage(m.resolved.id(), 0, GL_RGBA, GL_FLOAT, GLsizei(texels.size() * 16), texels.data());
     std::vector<glm::u16vec4> albedo(texels.size());
     glGetTextureImage(m.albedoMap.id(), 0, GL_RGBA, GL_HALF_FLOAT, GLsizei(albedo.size() * 8), albedo.data());
-    // restore the radiance map (resolveInto used it as dilation scratch)
-    m.resolveInto(true, m.radiance);
     LightmapPages out;
     out.resolution = res;
     for (int p = 0; p < m.layout.pageCount; ++p) {

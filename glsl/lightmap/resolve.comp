@@ -1,9 +1,12 @@
 #version 430
 // Resolve: light map L_lm = RGB / W (cosine-weighted mean of incoming
-// radiance, = E/pi; see update.frag and DESIGN.md Units) + the direct sun map. Writes, per texel of one page:
-//   RADIANCE_OUT: Lo = Le + albedo * L_lm (the next bundle passes read it)
-//   otherwise:    L_lm itself (output, preview)
-// alpha = 1 where the texel is covered by a triangle, 0 in padding (dilation fills it).
+// radiance, = E/pi; see update.frag and DESIGN.md Units) + the direct sun map.
+// Writes, per texel of every page:
+//   radianceOut: Lo = Le + albedo * L_lm (the next bundle passes read it)
+//   otherwise:   L_lm itself (output)
+// Padding texels take the value of their nearest covered texel (`source`,
+// computed once on the CPU), so bilinear lookups near chart edges stay right:
+// the dilation costs nothing per direction. alpha = 1 where a value exists.
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = 1, rg32ui) uniform readonly uimage2DArray accum;
@@ -11,6 +14,7 @@ layout(binding = 2, rgba32f) uniform readonly image2DArray sunMap;
 layout(binding = 3, rgba16f) uniform readonly image2DArray albedoMap;    // a = coverage
 layout(binding = 4, rgba16f) uniform readonly image2DArray emissionMap;
 layout(binding = 5, rgba32f) uniform writeonly image2DArray target;
+layout(binding = 6, r32i) uniform readonly iimage2DArray source;         // x | y << 16 of the texel to copy, or -1
 
 uniform bool radianceOut;
 uniform int pageCount;
@@ -21,16 +25,17 @@ float h2f(uint h) { return unpackHalf2x16(h & 0xFFFFu).x; }
 void main() {
     ivec3 t = ivec3(gl_GlobalInvocationID.xy, gl_GlobalInvocationID.z);
     if (t.x >= pageSize.x || t.y >= pageSize.y || t.z >= pageCount) return;
-    vec4 albedo = imageLoad(albedoMap, t);
-    if (albedo.a <= 0.0) {
+    int packedSource = imageLoad(source, t).r;
+    if (packedSource < 0) {
         imageStore(target, t, vec4(0.0));
         return;
     }
-    uvec2 p = imageLoad(accum, t).rg;
+    ivec3 s = ivec3(packedSource & 0xFFFF, packedSource >> 16, t.z);
+    uvec2 p = imageLoad(accum, s).rg;
     float w = h2f(p.y >> 16u);
     vec3 l = w > 0.0 ? vec3(h2f(p.x), h2f(p.x >> 16u), h2f(p.y)) / w : vec3(0.0);
-    vec4 sun = imageLoad(sunMap, t);  // rgb: sum over valid sun samples, a: their count
+    vec4 sun = imageLoad(sunMap, s);  // rgb: sum over valid sun samples, a: their count
     if (sun.a > 0.0) l += sun.rgb / sun.a;
-    vec3 value = radianceOut ? imageLoad(emissionMap, t).rgb + albedo.rgb * l : l;
+    vec3 value = radianceOut ? imageLoad(emissionMap, s).rgb + imageLoad(albedoMap, s).rgb * l : l;
     imageStore(target, t, vec4(value, 1.0));
 }
