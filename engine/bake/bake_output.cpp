@@ -1,10 +1,32 @@
 #include "bake/bake_output.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "io/image_io.h"
 
 namespace bb {
+
+namespace {
+
+// Preview exposure: the 75th percentile of covered texels' luminance maps to
+// 0.6 before the tone curve, so sunlit (L_lm ~ 1e3) and dim scenes both read.
+float autoExposure(const LightmapPages& maps) {
+    std::vector<float> lum;
+    for (size_t p = 0; p < maps.pages.size(); ++p)
+        for (size_t i = 0; i < maps.pages[p].pixels.size(); ++i)
+            if (maps.covered[p][i]) {
+                const glm::vec3& c = maps.pages[p].pixels[i];
+                lum.push_back(0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b);
+            }
+    if (lum.empty()) return 0.0f;
+    auto q = lum.begin() + std::ptrdiff_t(lum.size() * 3 / 4);
+    std::nth_element(lum.begin(), q, lum.end());
+    return *q > 0.0f ? std::log2(0.6f / *q) : 0.0f;
+}
+
+}  // namespace
 
 std::string lightmapFileName(int page, const char* extension) {
     char name[64];
@@ -17,6 +39,7 @@ Status writeBakeOutputs(const std::string& outDir, const Scene& scene, const Lay
     if (Status s = io::ensureDirectory(outDir); !s) return s;
     LightmapPages maps = baker.readLightmaps();
     const std::string units = "L_lm = E/pi (irradiance over pi), scene radiance units; row 0 = v 0 (glTF: v down from the top)";
+    const float exposure = autoExposure(maps);
     nlohmann::json pages = nlohmann::json::array();
     for (size_t p = 0; p < maps.pages.size(); ++p) {
         std::string exr = lightmapFileName(int(p));
@@ -24,8 +47,9 @@ Status writeBakeOutputs(const std::string& outDir, const Scene& scene, const Lay
         nlohmann::json page = {{"page", p}, {"exr", exr}};
         if (info.writePreviews) {
             std::string png = lightmapFileName(int(p), "png");
-            if (Status s = io::writePngToneMapped(outDir + "/" + png, maps.pages[p]); !s) return s;
+            if (Status s = io::writePngToneMapped(outDir + "/" + png, maps.pages[p], exposure); !s) return s;
             page["preview_png"] = png;
+            page["preview_exposure_stops"] = exposure;
         }
         pages.push_back(page);
     }

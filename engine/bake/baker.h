@@ -99,6 +99,13 @@ public:
     BakeProgress step(double seconds);
     BakeProgress progress() const;
 
+    // Checkpoints: the accumulators and progress, written atomically. A bake
+    // restored from a checkpoint continues to the same bytes an uninterrupted
+    // bake gives. loadCheckpoint fails (one line) if the file is not a
+    // checkpoint of this scene, layout and options.
+    Status saveCheckpoint(const std::string& path);
+    Status loadCheckpoint(const std::string& path);
+
     // Reads the current light maps back (resolve + dilate on the GPU).
     LightmapPages readLightmaps();
     // Raw accumulator read-back for tests: per page, per texel (R, G, B, W) as stored in fp16.

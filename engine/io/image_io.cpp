@@ -137,6 +137,9 @@ Status writeExrHalf(const std::string& path, const ImageRgb& image,
     if (Status s = checkImage(image); !s) return Status::error("cannot write " + path + ": " + s.message());
     OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::HALF);
     spec.attribute("compression", "zip");
+    // OIIO's EXR writer stamps the current time unless DateTime is set; an
+    // empty one keeps the file a function of its pixels (determinism).
+    spec.attribute("DateTime", "");
     for (const auto& [name, value] : attributes) spec.attribute(name, value);
     // OIIO converts float -> half with round to nearest (ties to even)
     static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "ImageRgb pixels must be packed RGB floats");

@@ -40,6 +40,11 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
     cmd.add_option("--history-power", a.historyPower,
                    "Weight direction k by min(k, N/2)^p to fade early, few-bounce directions (-1 = from the largest albedo)")
         ->capture_default_str();
+    cmd.add_option("--checkpoint-every", a.checkpointEvery,
+                   "Write OUTDIR/checkpoint.bin every N directions (0 = never)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    cmd.add_flag("--resume", a.resume, "Continue from OUTDIR/checkpoint.bin if it exists (same scene and flags)");
     cmd.add_flag("--no-preview", [&a](int64_t) { a.preview = false; }, "Do not write PNG previews");
     cmd.add_flag("--no-progress", [&a](int64_t) { a.progress = false; }, "No progress bar on stderr");
 }
@@ -80,11 +85,21 @@ int runBake(const BakeArgs& args) {
     auto baker = Baker::create(loaded->scene, loaded->layout, options);
     if (!baker) return fail(baker.error());
 
+    const std::string checkpoint = args.outDir + "/checkpoint.bin";
+    if (args.resume && std::filesystem::exists(checkpoint)) {
+        if (Status s = (*baker)->loadCheckpoint(checkpoint); !s) return fail(s.message());
+        logInfo("resuming from " + checkpoint + " at direction " + std::to_string((*baker)->progress().directionsDone));
+    }
     ProgressBar bar(args.progress && isatty(STDERR_FILENO));
     auto t0 = std::chrono::steady_clock::now();
+    int lastCheckpoint = (*baker)->progress().directionsDone;
     while (true) {
         BakeProgress p = (*baker)->step(0.25);
         bar.update(p.directionsDone, p.directionsTotal);
+        if (args.checkpointEvery > 0 && p.directionsDone - lastCheckpoint >= args.checkpointEvery && !p.done()) {
+            if (Status s = (*baker)->saveCheckpoint(checkpoint); !s) return fail(s.message());
+            lastCheckpoint = p.directionsDone;
+        }
         if (p.done()) break;
     }
     bar.finish();
@@ -100,6 +115,7 @@ int runBake(const BakeArgs& args) {
     info.wallSeconds = seconds;
     info.writePreviews = args.preview;
     if (Status s = writeBakeOutputs(args.outDir, loaded->scene, loaded->layout, **baker, info); !s) return fail(s.message());
+    if (args.checkpointEvery > 0 || args.resume) std::filesystem::remove(checkpoint);  // the outputs supersede it
     logInfo("baked " + std::to_string(options.directions) + " directions in " + std::to_string(seconds) + " s -> " +
             args.outDir);
     return 0;

@@ -1,0 +1,135 @@
+// The CPU reference baker: Monte Carlo path tracing on Intel Embree 3 from the
+// centre of every covered light map texel, into the same light maps as the
+// ray-bundle baker (same layout, same texels, same units L_lm = E/pi).
+//
+// Based on: J. Kajiya, "The Rendering Equation", SIGGRAPH 1986 (path tracing);
+// E. Veach, "Robust Monte Carlo Methods for Light Transport Simulation", PhD
+// thesis, 1997, ch. 9 (multiple importance sampling, power heuristic); M. Pharr,
+// W. Jakob, G. Humphreys, "Physically Based Rendering", 4th ed. (Russian
+// roulette, Owen-scrambled Sobol' samples, spawning rays off surfaces).
+//
+// What it computes, per covered texel (centre inside a triangle in page space):
+//   L_lm = (1/pi) * integral over the hemisphere of the shading normal of L_in cos
+// with L_in the radiance arriving from the first hit: Le + albedo * L_lm(hit),
+// recursively (all bounces, Russian roulette), a uniform sky or an
+// equirectangular environment where a ray escapes, and directional suns
+// (next-event estimated at every vertex, exact shadow test). The texel's own
+// emission is not part of its L_lm (DESIGN.md Units).
+//
+// Model, matched to the GPU baker (engine/bake/baker.h):
+// - coverage: a texel is covered when its centre lies inside a triangle in page
+//   space; edge ties follow a top-left rule (GL's rasterizer uses one too, but
+//   llvmpipe snaps to 1/256 texel, so a handful of texels exactly on chart
+//   edges may differ: compare over the texels both cover). Overlapping charts:
+//   the last triangle in the GPU meta pass's order (page, then material) wins.
+// - single-sided surfaces: a ray that hits a back face sees 0 (opaque black);
+//   emitters emit from their front only. Double-sided: either side is seen, with
+//   its own emission, and a path continues on the side it hit (the GPU baker
+//   reuses the front's L_lm for the back: they differ only where the two sides
+//   of a double-sided surface are lit differently).
+// - materials: albedo = factor x albedo texture (clamped to [0,1]), emission =
+//   factor x emission texture, textures sampled bilinearly (level 0, repeat) at
+//   the hit's TEXCOORD_0. (The GPU bakes them once per light map texel with
+//   trilinear filtering: the reference resolves texture detail below a texel.)
+// - environment: u = 0.5 + atan2(d.z, d.x) / 2pi, v = acos(d.y) / pi, image row
+//   0 = v 0 = the top (glsl/lightmap/update.frag environment()), bilinear,
+//   repeating in u and clamped in v (the GPU also repeats v, which blends the
+//   two poles in the first and last half row; nothing else differs).
+// - shading normals: the texel's hemisphere is that of its interpolated normal;
+//   a sampled direction below its triangle's plane is blocked (counts 0).
+//
+// Sampling: cosine-weighted directions (first bounce from a per-texel
+// Owen-scrambled Sobol' (0,2)-sequence, so every power-of-two prefix is
+// stratified), next-event estimation of emissive triangles (picked by power,
+// uniform by area) combined with the cosine samples by MIS, Russian roulette
+// after `rouletteDepth` bounces. Sample i of texel t depends only on (seed, page,
+// t, i): results are the same bits for any thread count and any pass split.
+//
+// Thread-safe: no. One ReferenceBaker is driven from one thread; it runs its
+// own worker threads inside step().
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+
+#include "bake/baker.h"  // LightmapPages
+#include "core/status.h"
+#include "io/image_io.h"
+#include "layout/bake_mesh.h"
+#include "layout/layout.h"
+#include "scene/scene.h"
+
+namespace bb {
+
+struct ReferenceOptions {
+    int spp = 1024;                 // samples (paths) per texel in all; typ. 64 .. 65536
+    int passSpp = 16;               // samples per texel per progressive pass (step() granularity)
+    int threads = 2;                // worker threads; 0 = std::thread::hardware_concurrency()
+    uint64_t seed = 1;
+    glm::vec3 sky{0.0f};            // uniform sky radiance (scene units)
+    std::optional<io::ImageRgb> environment;  // equirectangular radiance; replaces sky
+    bool emitterSampling = true;    // next-event estimation of emissive triangles (with MIS)
+    int rouletteDepth = 3;          // bounces before Russian roulette starts; typ. 2..5
+    int maxBounces = 1000;          // safety cap (bias below 0.5^1000 for any albedo <= 0.5... negligible)
+};
+
+struct ReferenceStats {
+    int sppDone = 0;
+    int sppTotal = 0;
+    int threads = 0;
+    int passes = 0;
+    int64_t lightmapTexels = 0;
+    int64_t coveredTexels = 0;
+    int64_t emitterTriangles = 0;
+    int64_t paths = 0;              // texel samples traced
+    int64_t rays = 0;               // closest-hit rays (path segments)
+    int64_t shadowRays = 0;         // occlusion rays (suns, emitters)
+    double secondsSetup = 0;        // BVH build, texel coverage
+    double secondsTrace = 0;        // path tracing passes
+    nlohmann::json toJson() const;
+};
+
+struct ReferenceProgress {
+    int sppDone = 0;
+    int sppTotal = 0;
+    bool done() const { return sppDone >= sppTotal; }
+};
+
+class ReferenceBaker {
+public:
+    // Builds the BVH and finds the covered texels. Errors: bad options
+    // (spp < 1, passSpp < 1, threads < 0), a scene without triangles.
+    static Expected<std::unique_ptr<ReferenceBaker>> create(const Scene& scene, const Layout& layout,
+                                                            const ReferenceOptions& options);
+    ~ReferenceBaker();
+
+    // Traces passes of passSpp samples per texel until `seconds` have passed (at
+    // least one pass, unless done).
+    ReferenceProgress step(double seconds);
+    ReferenceProgress progress() const;
+
+    // The current estimate: L_lm = sum / samples per covered texel, padding
+    // dilated as on the GPU (empty texels take the mean of their covered
+    // 8-neighbours, repeated), `covered` as found at create().
+    LightmapPages readLightmaps() const;
+
+    // The texel estimator at an arbitrary surface point (tests): L_lm at `point`
+    // on the side `normal` faces, from `spp` samples of stream `stream`
+    // (single-threaded). `normal` is used as both shading and geometric normal.
+    glm::vec3 estimate(const glm::vec3& point, const glm::vec3& normal, int spp, uint64_t stream) const;
+
+    const ReferenceStats& stats() const;
+    const BakeMesh& mesh() const;
+
+    struct Impl;
+
+private:
+    explicit ReferenceBaker(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace bb

@@ -1,0 +1,205 @@
+// Helpers for the GL and golden bake tests: load a scene from assets/, lay
+// it out, create a bb::Baker on the shared headless context, bake to the
+// end, and summarize light map texels. Header-only (tests/CMakeLists.txt
+// compiles tests/gl/*.cpp and tests/golden/*.cpp plus gl_fixture.cpp).
+#pragma once
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "bake/baker.h"
+#include "layout/bake_mesh.h"
+#include "layout/layout.h"
+#include "scene/scene.h"
+#include "support/gl_fixture.h"
+
+namespace bb::test {
+
+// A scene, its layout and a Baker made on the current context. `error` is
+// set (and baker null) when any step fails.
+struct SceneBake {
+    Scene scene;
+    Layout layout;
+    std::unique_ptr<Baker> baker;
+    std::string error;
+    explicit operator bool() const { return baker != nullptr; }
+};
+
+inline SceneBake makeBake(const std::string& assetRelative, const LayoutOptions& layoutOptions,
+                          const BakeOptions& bakeOptions) {
+    SceneBake out;
+    auto scene = loadScene(sourcePath(assetRelative));
+    if (!scene) {
+        out.error = "loadScene: " + scene.error();
+        return out;
+    }
+    out.scene = std::move(scene.value());
+    auto layout = computeLayout(out.scene, layoutOptions);
+    if (!layout) {
+        out.error = "computeLayout: " + layout.error();
+        return out;
+    }
+    out.layout = std::move(layout.value());
+    auto baker = Baker::create(out.scene, out.layout, bakeOptions);
+    if (!baker) {
+        out.error = "Baker::create: " + baker.error();
+        return out;
+    }
+    out.baker = std::move(baker.value());
+    return out;
+}
+
+inline LayoutOptions assetLayout(int resolution) {
+    LayoutOptions o;
+    o.mode = UvLayout::Asset;
+    o.resolution = resolution;
+    return o;
+}
+
+// Bakes every remaining direction; returns the wall time in seconds.
+inline double bakeToEnd(Baker& baker) {
+    auto t0 = std::chrono::steady_clock::now();
+    while (!baker.step(1e9).done()) {
+    }
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Min / max / mean of one channel (or all three) over a set of texels.
+struct Summary {
+    size_t count = 0;
+    double mean = 0;
+    double min = std::numeric_limits<double>::infinity();
+    double max = -std::numeric_limits<double>::infinity();
+    size_t argMin = 0, argMax = 0;  // texel index y * R + x
+    void add(double value, size_t index) {
+        ++count;
+        mean += value;  // sum until finish()
+        if (value < min) min = value, argMin = index;
+        if (value > max) max = value, argMax = index;
+    }
+    void finish() {
+        if (count) mean /= double(count);
+    }
+};
+
+inline std::string texelName(size_t index, int resolution) {
+    return "texel (" + std::to_string(index % size_t(resolution)) + ", " + std::to_string(index / size_t(resolution)) +
+           ")";
+}
+
+// Summary of every channel of every covered texel of one page.
+inline Summary summarizeCovered(const LightmapPages& maps, int page = 0) {
+    Summary s;
+    const auto& img = maps.pages[size_t(page)];
+    const auto& cov = maps.covered[size_t(page)];
+    for (size_t i = 0; i < img.pixels.size(); ++i) {
+        if (!cov[i]) continue;
+        for (int c = 0; c < 3; ++c) s.add(img.pixels[i][c], i);
+    }
+    s.finish();
+    return s;
+}
+
+inline std::string describe(const Summary& s, int resolution) {
+    char buf[256];
+    std::snprintf(buf, sizeof buf, "%zu values: mean %.6f, min %.6f at %s, max %.6f at %s", s.count, s.mean, s.min,
+                  texelName(s.argMin, resolution).c_str(), s.max, texelName(s.argMax, resolution).c_str());
+    return buf;
+}
+
+// The expected furnace value after N directions with the baker's history
+// ramp (BakeOptions::historyPower; direction k, 1-based, weighs
+// min(k, N/2)^p): L_lm is the weighted mean of the incoming radiance seen by
+// each direction, Le + rho * (the light map after the previous direction),
+// so M_k = sum_j w_j (Le + rho M_{j-1}) / sum_j w_j, M_0 = 0. This is the
+// bake's expectation in a furnace (every texel sees the same value); its gap
+// to Le / (1 - rho) is the start-up bias of the iteration.
+inline double furnaceExpectation(double le, double rho, int directions, double historyPower) {
+    const double rampEnd = std::max(1, directions / 2);
+    double sum = 0, weights = 0, m = 0;
+    for (int k = 0; k < directions; ++k) {
+        const double w = std::pow(std::min(double(k + 1), rampEnd), historyPower);
+        sum += w * (le + rho * m);
+        weights += w;
+        m = sum / weights;
+    }
+    return m;
+}
+
+// The baker's default history power for a largest albedo rho (BakeOptions::historyPower < 0).
+inline double defaultHistoryPower(double rho) {
+    rho = std::min(rho, 0.99);
+    return std::clamp(std::round(2.0 * rho / (1.0 - rho)), 1.0, 32.0);
+}
+
+// --- texels to triangles (CPU) ----------------------------------------------
+
+// Which triangle of the bake mesh covers each texel centre of a page
+// (texel (x, y) centre at ((x + 0.5) / R, (y + 0.5) / R) in page UV, row y =
+// v, as GL rasterizes the meta pass). -1 where none does. Texel centres
+// exactly on a shared edge take the first triangle that contains them.
+inline std::vector<int> texelTriangles(const BakeMesh& mesh, int resolution, int page = 0) {
+    std::vector<int> owner(size_t(resolution) * resolution, -1);
+    const float r = float(resolution);
+    for (uint32_t t = mesh.pageFirstTriangle[size_t(page)]; t < mesh.pageFirstTriangle[size_t(page) + 1]; ++t) {
+        glm::vec2 a = mesh.vertices[3 * t].lightmapUv * r;
+        glm::vec2 b = mesh.vertices[3 * t + 1].lightmapUv * r;
+        glm::vec2 c = mesh.vertices[3 * t + 2].lightmapUv * r;
+        auto edge = [](glm::vec2 p, glm::vec2 q, glm::vec2 x) {
+            return double(q.x - p.x) * (x.y - p.y) - double(q.y - p.y) * (x.x - p.x);
+        };
+        const double area = edge(a, b, c);
+        if (area == 0) continue;
+        int x0 = std::max(0, int(std::floor(std::min({a.x, b.x, c.x}))));
+        int x1 = std::min(resolution - 1, int(std::ceil(std::max({a.x, b.x, c.x}))));
+        int y0 = std::max(0, int(std::floor(std::min({a.y, b.y, c.y}))));
+        int y1 = std::min(resolution - 1, int(std::ceil(std::max({a.y, b.y, c.y}))));
+        for (int y = y0; y <= y1; ++y)
+            for (int x = x0; x <= x1; ++x) {
+                glm::vec2 p(x + 0.5f, y + 0.5f);
+                double w0 = edge(b, c, p), w1 = edge(c, a, p), w2 = edge(a, b, p);
+                bool inside = area > 0 ? (w0 >= 0 && w1 >= 0 && w2 >= 0) : (w0 <= 0 && w1 <= 0 && w2 <= 0);
+                size_t i = size_t(y) * resolution + x;
+                if (inside && owner[i] < 0) owner[i] = int(t);
+            }
+    }
+    return owner;
+}
+
+// The triangle whose light map footprint is nearest to the texel centre (for
+// covered texels whose centre no triangle contains: GL rasterization and
+// this test can disagree by rounding on an edge).
+inline int nearestTriangle(const BakeMesh& mesh, int resolution, size_t texel, int page = 0) {
+    const float r = float(resolution);
+    glm::vec2 p((float(texel % size_t(resolution)) + 0.5f) / r, (float(texel / size_t(resolution)) + 0.5f) / r);
+    auto segDist = [](glm::vec2 x, glm::vec2 a, glm::vec2 b) {
+        glm::vec2 ab = b - a;
+        float t = glm::clamp(glm::dot(x - a, ab) / std::max(glm::dot(ab, ab), 1e-20f), 0.0f, 1.0f);
+        return glm::length(x - (a + t * ab));
+    };
+    int best = -1;
+    float bestDist = 1e30f;
+    for (uint32_t t = mesh.pageFirstTriangle[size_t(page)]; t < mesh.pageFirstTriangle[size_t(page) + 1]; ++t) {
+        glm::vec2 a = mesh.vertices[3 * t].lightmapUv, b = mesh.vertices[3 * t + 1].lightmapUv,
+                  c = mesh.vertices[3 * t + 2].lightmapUv;
+        float d = std::min({segDist(p, a, b), segDist(p, b, c), segDist(p, c, a)});
+        if (d < bestDist) bestDist = d, best = int(t);
+    }
+    return best;
+}
+
+inline glm::vec3 triangleCentroid(const BakeMesh& mesh, int t) {
+    return glm::vec3(mesh.vertices[3 * size_t(t)].position + mesh.vertices[3 * size_t(t) + 1].position +
+                     mesh.vertices[3 * size_t(t) + 2].position) /
+           3.0f;
+}
+
+}  // namespace bb::test
