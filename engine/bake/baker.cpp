@@ -11,6 +11,7 @@
 #include "core/log.h"
 #include "core/memory.h"
 #include "gl/gl.h"
+#include <glm/gtc/matrix_transform.hpp>
 #include "gl/objects.h"
 #include "gl/shader.h"
 #include "glsl/shared/bundle_layout.h"
@@ -86,7 +87,10 @@ struct Baker::Impl {
     gl::VertexArray vao;
     gl::Texture albedoMap, emissionMap, accum, sunMap, radiance, resolved, heads, envTexture, dilationSource;
     gl::Framebuffer bundleFbo, pageFbo, metaFbo;
-    gl::Program appendProgram, updateProgram, sunProgram, resolveProgram, rescaleProgram, metaProgram;
+    gl::Program appendProgram, updateProgram, sunProgram, resolveProgram, rescaleProgram, metaProgram, distanceProgram,
+        emitterProgram;
+    gl::Texture emitterMap;
+    std::vector<glm::vec3> textureMeans;  // mean linear RGB of each scene texture (explicit emitters)
     std::vector<gl::Texture> materialTextures;
     int64_t nodeCapacity = 0;
 
@@ -95,6 +99,8 @@ struct Baker::Impl {
     void uploadMesh();
     void metaPass(const Scene& scene);
     void bakeSun();
+    bool useExplicitEmitters() const;
+    void bakeEmitters();
     void bakeDirection(int index);
     // Draws the bundle of direction d over the given tiles (splitting on
     // overflow) and runs `update` for each tile that fits.
@@ -148,6 +154,8 @@ Status Baker::Impl::buildPrograms() {
         {&resolveProgram, {"lightmap/resolve.comp"}, ""},
         {&rescaleProgram, {"lightmap/rescale.comp"}, rounding},
         {&metaProgram, {"lightmap/meta.vert", "lightmap/meta.frag"}, ""},
+        {&distanceProgram, {"direct/distance.vert", "direct/distance.frag"}, ""},
+        {&emitterProgram, {"direct/emitter.vert", "direct/emitter.frag"}, ""},
     };
     for (auto& s : specs) {
         auto p = gl::buildProgram(s.files, s.defines);
@@ -253,6 +261,11 @@ void Baker::Impl::metaPass(const Scene& scene) {
 Status Baker::Impl::init(const Scene& scene) {
     auto t0 = Clock::now();
     materials = scene.materials;
+    for (const auto& t : scene.textures) {
+        glm::dvec3 sum(0.0);
+        for (const auto& texel : t.texels) sum += glm::dvec3(texel);
+        textureMeans.push_back(t.texels.empty() ? glm::vec3(1.0f) : glm::vec3(sum / double(t.texels.size())));
+    }
     lights = scene.lights;
     stats.directionsTotal = options.directions;
     if (options.directions < 1) return Status::error("--directions must be at least 1");
@@ -335,6 +348,7 @@ Status Baker::Impl::init(const Scene& scene) {
     emissionMap = gl::Texture::create2DArray("emission map", GL_RGBA16F, res, res, pages);
     accum = gl::Texture::create2DArray("accumulators (fp16 RGB+W)", GL_RG32UI, res, res, pages);
     sunMap = gl::Texture::create2DArray("direct sun map", GL_RGBA32F, res, res, pages);
+    emitterMap = gl::Texture::create2DArray("direct emitter map", GL_RGBA32F, res, res, pages);
     radiance = gl::Texture::create2DArray("outgoing radiance map", GL_RGBA32F, res, res, pages);
     resolved = gl::Texture::create2DArray("resolved light map", GL_RGBA32F, res, res, pages);
     glTextureParameteri(radiance.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
@@ -343,6 +357,7 @@ Status Baker::Impl::init(const Scene& scene) {
     const float zeroF[4] = {0, 0, 0, 0};
     glClearTexImage(accum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, zeroU);
     glClearTexImage(sunMap.id(), 0, GL_RGBA, GL_FLOAT, zeroF);
+    glClearTexImage(emitterMap.id(), 0, GL_RGBA, GL_FLOAT, zeroF);
     glClearTexImage(radiance.id(), 0, GL_RGBA, GL_FLOAT, zeroF);
     heads = gl::Texture::create2D("bundle head pointers", GL_R32UI, maxTileSize, maxTileSize);
     nodeBuffer = gl::Buffer::create("bundle nodes", nodeCapacity * 12, nullptr, 0);
@@ -387,6 +402,11 @@ Status Baker::Impl::init(const Scene& scene) {
     glTextureSubImage3D(dilationSource.id(), 0, 0, 0, 0, res, res, pages, GL_RED_INTEGER, GL_INT, source.data());
     stats.secondsSetup = secondsSince(t0);
 
+    stats.explicitEmitters = useExplicitEmitters();
+    auto te = Clock::now();
+    if (stats.explicitEmitters) bakeEmitters();
+    glFinish();
+    stats.secondsEmitters = secondsSince(te);
     auto ts = Clock::now();
     bakeSun();
     stats.secondsSun = secondsSince(ts);
@@ -530,6 +550,118 @@ void Baker::Impl::bakeSun() {
     }
 }
 
+bool Baker::Impl::useExplicitEmitters() const {
+    using D = BakeOptions::DirectLight;
+    if (options.directLight != D::Auto) return options.directLight == D::Explicit;
+    size_t emitters = 0;
+    double emitterArea = 0, area = 0;
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+        area += projectedArea[t];
+        if (mesh.triangles[t].flags & TRIANGLE_EMISSIVE) {
+            ++emitters;
+            emitterArea += projectedArea[t];
+        }
+    }
+    return emitters > 0 && emitters <= 1024 && emitterArea <= 0.25 * area;
+}
+
+void Baker::Impl::bakeEmitters() {
+    gl::DebugGroup group("explicit emitters");
+    // emitters and their sample counts, proportional to area x luminance (>= 1 each)
+    struct Emitter {
+        size_t triangle;
+        glm::vec3 radiance;
+        double power;
+        int samples = 1;
+    };
+    std::vector<Emitter> emitters;
+    double totalPower = 0;
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+        if (!(mesh.triangles[t].flags & TRIANGLE_EMISSIVE)) continue;
+        const Material& m = materials[mesh.triangles[t].material];
+        glm::vec3 le = m.emission * (m.emissionTexture >= 0 ? textureMeans[size_t(m.emissionTexture)] : glm::vec3(1.0f));
+        double power = projectedArea[t] * (0.2126 * le.r + 0.7152 * le.g + 0.0722 * le.b);
+        emitters.push_back({t, le, power});
+        totalPower += power;
+    }
+    if (emitters.empty()) return;
+    for (auto& e : emitters)
+        e.samples = std::max(1, int(std::lround(options.emitterSamples * (totalPower > 0 ? e.power / totalPower : 0.0))));
+
+    const int size = std::max(16, options.emitterShadowSize);
+    gl::Texture cube = gl::Texture::createCube("emitter sample distances", GL_R32F, size);
+    glTextureParameteri(cube.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(cube.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    gl::Texture depth = gl::Texture::create2D("emitter sample depth", GL_DEPTH_COMPONENT32F, size, size);
+    gl::Framebuffer fbo = gl::Framebuffer::create("emitter sample cube face");
+    glNamedFramebufferTexture(fbo.id(), GL_DEPTH_ATTACHMENT, depth.id(), 0);
+
+    const glm::vec3 faceDir[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    const glm::vec3 faceUp[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
+    const float nearPlane = 1e-4f * sphereRadius, farPlane = 4.0f * sphereRadius;
+    const glm::mat4 projection = glm::perspective(glm::radians(90.0f), 1.0f, nearPlane, farPlane);
+    const float farValue = 1e30f;
+    const float normalOffset = 0.5f * pixelSize;
+    const float distanceBias = 2.0f * pixelSize;
+
+    for (const Emitter& e : emitters) {
+        const BakeVertex* v = &mesh.vertices[e.triangle * 3];
+        glm::vec3 a(v[0].position), b(v[1].position), c(v[2].position);
+        glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
+        bool doubleSided = mesh.triangles[e.triangle].flags & TRIANGLE_DOUBLE_SIDED;
+        glm::vec3 perSample = e.radiance / float(e.samples);
+        for (int i = 0; i < e.samples; ++i) {
+            // stratified point on the triangle: R2 sequence (Roberts 2018), folded
+            double su = std::fmod(0.5 + 0.7548776662466927 * (i + 1), 1.0);
+            double sv = std::fmod(0.5 + 0.5698402909980532 * (i + 1), 1.0);
+            if (su + sv > 1.0) {
+                su = 1.0 - su;
+                sv = 1.0 - sv;
+            }
+            glm::vec3 point = a + float(su) * (b - a) + float(sv) * (c - a) + n * (1e-4f * pixelSize);
+            // distance cube map
+            glUseProgram(distanceProgram.id());
+            glUniform3fv(distanceProgram.uniform("samplePoint"), 1, &point.x);
+            glEnable(GL_DEPTH_TEST);
+            glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
+            glViewport(0, 0, size, size);
+            for (int f = 0; f < 6; ++f) {
+                glNamedFramebufferTextureLayer(fbo.id(), GL_COLOR_ATTACHMENT0, cube.id(), 0, f);
+                glm::mat4 clipFromWorld = projection * glm::lookAt(point, point + faceDir[f], faceUp[f]);
+                glUniformMatrix4fv(distanceProgram.uniform("clipFromWorld"), 1, GL_FALSE, &clipFromWorld[0][0]);
+                glClearNamedFramebufferfv(fbo.id(), GL_COLOR, 0, &farValue);
+                glClearNamedFramebufferfi(fbo.id(), GL_DEPTH_STENCIL, 0, 1.0f, 0);
+                glDrawArrays(GL_TRIANGLES, 0, GLsizei(mesh.vertices.size()));
+            }
+            glDisable(GL_DEPTH_TEST);
+            // accumulate this sample's share into the direct map, page by page
+            glUseProgram(emitterProgram.id());
+            glUniform3fv(emitterProgram.uniform("emitterA"), 1, &a.x);
+            glUniform3fv(emitterProgram.uniform("emitterB"), 1, &b.x);
+            glUniform3fv(emitterProgram.uniform("emitterC"), 1, &c.x);
+            glUniform3fv(emitterProgram.uniform("emitterNormal"), 1, &n.x);
+            glUniform1i(emitterProgram.uniform("emitterDoubleSided"), doubleSided);
+            glUniform3fv(emitterProgram.uniform("radianceOverSamples"), 1, &perSample.x);
+            glUniform3fv(emitterProgram.uniform("samplePoint"), 1, &point.x);
+            glUniform1f(emitterProgram.uniform("normalOffset"), normalOffset);
+            glUniform1f(emitterProgram.uniform("distanceBias"), distanceBias);
+            glBindTextureUnit(0, cube.id());
+            glBindImageTexture(BINDING_SUN, emitterMap.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
+            glBindFramebuffer(GL_FRAMEBUFFER, pageFbo.id());
+            glViewport(0, 0, layout.resolution, layout.resolution);
+            for (int page = 0; page < layout.pageCount; ++page) {
+                glUniform1i(emitterProgram.uniform("page"), page);
+                GLint first = GLint(mesh.pageFirstTriangle[page] * 3);
+                GLsizei count = GLsizei((mesh.pageFirstTriangle[page + 1] - mesh.pageFirstTriangle[page]) * 3);
+                if (count) glDrawArrays(GL_TRIANGLES, first, count);
+            }
+            glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+            ++stats.emitterSampleCount;
+        }
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
 void Baker::Impl::bakeDirection(int k) {
     const glm::vec3 d = directions[size_t(k)];
     // history ramp: weight min(k+1, K)^power relative to the stored scale
@@ -582,6 +714,8 @@ void Baker::Impl::resolveInto(bool radianceOut, gl::Texture& target) {
     gl::DebugGroup group("resolve");
     glUseProgram(resolveProgram.id());
     glUniform1i(resolveProgram.uniform("radianceOut"), radianceOut);
+    glUniform1i(resolveProgram.uniform("includeEmission"), !stats.explicitEmitters);
+    glBindImageTexture(7, emitterMap.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
     glBindImageTexture(1, accum.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RG32UI);
     glBindImageTexture(2, sunMap.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
     glBindImageTexture(3, albedoMap.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
@@ -783,5 +917,28 @@ Status Baker::loadCheckpoint(const std::string& path) {
 
 const BakeStats& Baker::stats() const { return impl_->stats; }
 const BakeMesh& Baker::mesh() const { return impl_->mesh; }
+
+void Baker::resolveLightmaps() { impl_->resolveInto(false, impl_->resolved); }
+
+uint32_t Baker::lightmapTextureId() const { return impl_->resolved.id(); }
+
+Baker::BundleGrid Baker::bundleGrid() const {
+    const Impl& m = *impl_;
+    BundleGrid g;
+    const int k = std::max(0, m.stats.directionsDone - 1);
+    if (m.directions.empty()) return g;
+    g.dir = m.directions[size_t(k)];
+    orthonormalBasis(g.dir, g.u, g.v);
+    g.origin = glm::vec2(glm::dot(m.sphereCenter, g.u), glm::dot(m.sphereCenter, g.v)) - glm::vec2(m.sphereRadius);
+    g.pixelSize = m.pixelSize;
+    g.gridSize = m.gridSize;
+    // the initial grid of traceBundle (keep in step with it)
+    const double predicted = m.predictNodes(g.dir);
+    int perSide = (m.gridSize + m.maxTileSize - 1) / m.maxTileSize;
+    while (predicted / (double(perSide) * perSide) > 0.8 * m.nodeCapacity && perSide < m.gridSize) perSide *= 2;
+    g.tileStep = (m.gridSize + perSide - 1) / perSide;
+    g.tiles = m.stats.directionsDone > 0 && !m.stats.tilesPerDirection.empty() ? m.stats.tilesPerDirection.back() : 0;
+    return g;
+}
 
 }  // namespace bb

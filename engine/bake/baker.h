@@ -44,6 +44,14 @@ struct BakeOptions {
     // the scene's largest albedo: round(2 rho / (1 - rho)), clamped to [1, 32].
     float historyPower = -1.0f;
     int sunJitter = 2;                // sun bundles per axis (jittered sub-pixel), for antialiased shadows
+    // Direct light from emissive triangles: Explicit = exact polygon form
+    // factor times visibility from `emitterSamples` shadow cube maps (small
+    // area lights, which uniform bundle directions rarely see); Bundles = the
+    // bundles carry emission like any radiance; Auto = Explicit when emitters
+    // are at most 1024 triangles and 25% of the surface area.
+    enum class DirectLight { Auto, Explicit, Bundles } directLight = DirectLight::Auto;
+    int emitterSamples = 128;         // visibility samples over all explicit emitters (>= 1 per triangle)
+    int emitterShadowSize = 256;      // cube face size of each sample's distance map
 };
 
 // Figures every bake reports (stats.json).
@@ -66,8 +74,13 @@ struct BakeStats {
     int64_t coveredTexels = 0;
     std::vector<double> predictedOverActual;  // per tile: predicted nodes / actual nodes
     std::vector<int> tilesPerDirection;
+    bool explicitEmitters = false;
+    int emitterSampleCount = 0;
+    double secondsEmitters = 0;
     double secondsSetup = 0, secondsSun = 0, secondsBundle = 0, secondsUpdate = 0, secondsResolve = 0;
-    double secondsTotal() const { return secondsSetup + secondsSun + secondsBundle + secondsUpdate + secondsResolve; }
+    double secondsTotal() const {
+        return secondsSetup + secondsSun + secondsEmitters + secondsBundle + secondsUpdate + secondsResolve;
+    }
     nlohmann::json toJson() const;
 };
 
@@ -129,6 +142,28 @@ public:
 
     const BakeStats& stats() const;
     const BakeMesh& mesh() const;
+
+    // --- live view (viewer, render tests) -------------------------------------
+    // Resolves the current light maps into the texture lightmapTextureId()
+    // names, on the GPU, without reading back (readLightmaps does the same and
+    // reads back). Costs one compute pass over the pages.
+    void resolveLightmaps();
+    // GL name of the resolved light maps: RGBA32F 2D array, one layer per page,
+    // rgb = L_lm (E/pi), a = 1 where a value exists (padding dilated). Owned by
+    // the Baker; valid for its life; filled by resolveLightmaps()/readLightmaps().
+    uint32_t lightmapTextureId() const;
+    // The bundle plane of the latest direction (direction 0 before any), for
+    // overlays: frame, pixel grid, and the initial tile grid (tileStep pixels
+    // square) as traceBundle lays it out before overflow splits.
+    struct BundleGrid {
+        glm::vec3 dir{0.0f, 0.0f, 1.0f}, u{1.0f, 0.0f, 0.0f}, v{0.0f, 1.0f, 0.0f};
+        glm::vec2 origin{0.0f};  // (u, v) of pixel (0, 0)'s lower-left corner
+        float pixelSize = 1.0f;  // scene units
+        int gridSize = 1;        // pixels across the bundle
+        int tileStep = 1;        // pixels per tile side
+        int tiles = 0;           // tiles drawn for that direction (with splits); 0 before any
+    };
+    BundleGrid bundleGrid() const;
 
     struct Impl;
 

@@ -60,13 +60,13 @@ int bytesPerTexel(GLenum f) {
 
 namespace {
 Texture makeTexture(const std::string& label, GLenum target, GLenum internalFormat, int width, int height, int layers,
-                    int levels) {
+                    int levels, int faces = 1) {
     CHECK_GT(width, 0);
     CHECK_GT(height, 0);
     CHECK_GT(layers, 0);
     GLuint name = 0;
     glCreateTextures(target, 1, &name);
-    if (target == GL_TEXTURE_2D_ARRAY)
+    if (target == GL_TEXTURE_2D_ARRAY || target == GL_TEXTURE_CUBE_MAP_ARRAY)
         glTextureStorage3D(name, levels, internalFormat, width, height, layers);
     else
         glTextureStorage2D(name, levels, internalFormat, width, height);
@@ -74,7 +74,7 @@ Texture makeTexture(const std::string& label, GLenum target, GLenum internalForm
     glTextureParameteri(name, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glTextureParameteri(name, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTextureParameteri(name, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    return Texture::adoptTexture(name, label, internalFormat, width, height, layers, levels);
+    return Texture::adoptTexture(name, label, internalFormat, width, height, layers * faces, levels);
 }
 }  // namespace
 
@@ -97,6 +97,10 @@ Texture Texture::create2D(const std::string& label, GLenum internalFormat, int w
 
 Texture Texture::create2DLevels(const std::string& label, GLenum internalFormat, int width, int height, int levels) {
     return makeTexture(label, GL_TEXTURE_2D, internalFormat, width, height, 1, levels);
+}
+
+Texture Texture::createCube(const std::string& label, GLenum internalFormat, int size) {
+    return makeTexture(label, GL_TEXTURE_CUBE_MAP, internalFormat, size, size, 1, 1, 6);
 }
 
 Texture Texture::create2DArray(const std::string& label, GLenum internalFormat, int width, int height, int layers) {

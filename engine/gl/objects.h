@@ -55,6 +55,8 @@ public:
     static Texture create2D(const std::string& label, GLenum internalFormat, int width, int height);
     // 2D texture with `levels` mip levels (call glGenerateTextureMipmap after upload).
     static Texture create2DLevels(const std::string& label, GLenum internalFormat, int width, int height, int levels);
+    // Cube map, one level, six faces of size x size.
+    static Texture createCube(const std::string& label, GLenum internalFormat, int size);
     // 2D array texture, one level, `layers` layers (light map pages).
     static Texture create2DArray(const std::string& label, GLenum internalFormat, int width, int height, int layers);
     static void destroy(GLuint name) { glDeleteTextures(1, &name); }

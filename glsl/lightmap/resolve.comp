@@ -1,6 +1,7 @@
 #version 430
 // Resolve: light map L_lm = RGB / W (cosine-weighted mean of incoming
-// radiance, = E/pi; see update.frag and DESIGN.md Units) + the direct sun map.
+// radiance, = E/pi; see update.frag and DESIGN.md Units) + the direct sun
+// and explicit emitter maps.
 // Writes, per texel of every page:
 //   radianceOut: Lo = Le + albedo * L_lm (the next bundle passes read it)
 //   otherwise:   L_lm itself (output)
@@ -15,8 +16,10 @@ layout(binding = 3, rgba16f) uniform readonly image2DArray albedoMap;    // a = 
 layout(binding = 4, rgba16f) uniform readonly image2DArray emissionMap;
 layout(binding = 5, rgba32f) uniform writeonly image2DArray target;
 layout(binding = 6, r32i) uniform readonly iimage2DArray source;         // x | y << 16 of the texel to copy, or -1
+layout(binding = 7, rgba32f) uniform readonly image2DArray emitterMap;  // explicit direct light from emitters (L_lm)
 
 uniform bool radianceOut;
+uniform bool includeEmission;  // false when emitters are lit explicitly: bundles then carry reflected light only
 uniform int pageCount;
 uniform ivec2 pageSize;
 
@@ -36,6 +39,8 @@ void main() {
     vec3 l = w > 0.0 ? vec3(h2f(p.x), h2f(p.x >> 16u), h2f(p.y)) / w : vec3(0.0);
     vec4 sun = imageLoad(sunMap, s);  // rgb: sum over valid sun samples, a: their count
     if (sun.a > 0.0) l += sun.rgb / sun.a;
-    vec3 value = radianceOut ? imageLoad(emissionMap, s).rgb + imageLoad(albedoMap, s).rgb * l : l;
+    l += imageLoad(emitterMap, s).rgb;
+    vec3 emission = includeEmission ? imageLoad(emissionMap, s).rgb : vec3(0.0);
+    vec3 value = radianceOut ? emission + imageLoad(albedoMap, s).rgb * l : l;
     imageStore(target, t, vec4(value, 1.0));
 }

@@ -1,0 +1,37 @@
+#version 450
+// Direct light from an emissive triangle, one of its visibility samples:
+// L_lm += Le * F(x -> triangle) * V(x, sample) / sampleCount, with F the exact
+// polygon form factor (no 1/r^2 noise near the emitter) and V read from the
+// sample's distance cube map. Accumulates into the direct map (rgb).
+#include "lib/polygon_irradiance.glsl"
+
+in vec3 vPosition;
+in vec3 vNormal;
+
+layout(binding = 2, rgba32f) uniform coherent image2DArray directMap;
+layout(binding = 0) uniform samplerCube distances;
+uniform vec3 emitterA, emitterB, emitterC;  // world vertices
+uniform vec3 emitterNormal;
+uniform bool emitterDoubleSided;
+uniform vec3 radianceOverSamples;         // Le / samples of this triangle
+uniform vec3 samplePoint;
+uniform float normalOffset;                // scene units: pushes x off its own surface
+uniform float distanceBias;                // scene units
+uniform int page;
+
+void main() {
+    if (gl_HelperInvocation) return;
+    vec3 n = normalize(vNormal);
+    vec3 x = vPosition + n * normalOffset;
+    vec3 toX = x - samplePoint;
+    float facing = dot(emitterNormal, toX);
+    if (!emitterDoubleSided && facing <= 0.0) return;  // behind a single-sided emitter
+    if (dot(n, -toX) <= 0.0) return;                   // the sample is below x's horizon
+    float dist = length(toX);
+    float stored = texture(distances, toX).r;
+    if (dist > stored + distanceBias + 0.002 * dist) return;  // occluded
+    float f = polygonFormFactor(x, n, emitterA, emitterB, emitterC);
+    ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), page);
+    vec4 s = imageLoad(directMap, texel);
+    imageStore(directMap, texel, vec4(s.rgb + radianceOverSamples * f, 1.0));
+}
