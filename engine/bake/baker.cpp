@@ -132,11 +132,12 @@ nlohmann::json BakeStats::toJson() const {
                    {"node_buffer_bytes", nodeBufferBytes}, {"head_image_bytes", headImageBytes},
                    {"peak_gpu_bytes", peakGpuBytes}, {"bytes_per_node", 12}, {"bytes_per_lightmap_texel", 8}};
     j["lightmap"] = {{"texels", lightmapTexels}, {"covered_texels", coveredTexels}};
+    j["direct_light"] = {{"explicit_emitters", explicitEmitters}, {"emitter_samples", emitterSampleCount}};
     double bundleSeconds = secondsBundle > 0 ? secondsBundle : 1e-9;
     double updateSeconds = secondsUpdate > 0 ? secondsUpdate : 1e-9;
     j["throughput"] = {{"fragments", fragments}, {"fragments_per_second_bundle_pass", fragments / bundleSeconds},
                        {"texel_samples", updatedTexels}, {"texel_samples_per_second_update_pass", updatedTexels / updateSeconds}};
-    j["seconds"] = {{"setup", secondsSetup}, {"sun", secondsSun}, {"bundle", secondsBundle}, {"update", secondsUpdate},
+    j["seconds"] = {{"setup", secondsSetup}, {"sun", secondsSun}, {"emitters", secondsEmitters}, {"bundle", secondsBundle}, {"update", secondsUpdate},
                     {"resolve", secondsResolve}, {"total", secondsTotal()}};
     return j;
 }

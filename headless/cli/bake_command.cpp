@@ -40,6 +40,14 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
     cmd.add_option("--history-power", a.historyPower,
                    "Weight direction k by min(k, N/2)^p to fade early, few-bounce directions (-1 = from the largest albedo)")
         ->capture_default_str();
+    cmd.add_option("--direct", a.direct,
+                   "Direct light from emissive triangles: explicit (form factor x shadow cube maps), bundles, or auto "
+                   "(explicit for small emitters)")
+        ->check(CLI::IsMember({"auto", "explicit", "bundles"}))
+        ->capture_default_str();
+    cmd.add_option("--emitter-samples", a.emitterSamples, "Visibility samples over all explicit emitters")
+        ->check(CLI::Range(1, 1 << 16))
+        ->capture_default_str();
     cmd.add_option("--checkpoint-every", a.checkpointEvery,
                    "Write OUTDIR/checkpoint.bin every N directions (0 = never)")
         ->check(CLI::NonNegativeNumber)
@@ -71,6 +79,10 @@ int runBake(const BakeArgs& args) {
     options.sky = *sky;
     options.rounding = args.rounding == "nearest" ? Rounding::Nearest : Rounding::Stochastic;
     options.historyPower = args.historyPower;
+    options.directLight = args.direct == "explicit" ? BakeOptions::DirectLight::Explicit
+                        : args.direct == "bundles"  ? BakeOptions::DirectLight::Bundles
+                                                    : BakeOptions::DirectLight::Auto;
+    options.emitterSamples = args.emitterSamples;
     if (!args.env.empty()) {
         auto env = io::readImageRgb(args.env);
         if (!env) return fail(env.error());
@@ -111,10 +123,12 @@ int runBake(const BakeArgs& args) {
     info.settings = {{"directions", args.directions}, {"bundle_res", args.bundleRes}, {"memory_budget", args.memoryBudget},
                      {"seed", args.seed}, {"sky", args.sky}, {"env", args.env}, {"rounding", args.rounding},
                      {"uv_layout", args.scene.uvLayout}, {"resolution", args.scene.resolution},
-                     {"texel_density", args.scene.texelDensity}, {"history_power", (*baker)->stats().historyPower}};
+                     {"texel_density", args.scene.texelDensity}, {"history_power", (*baker)->stats().historyPower},
+                     {"direct", args.direct}, {"emitter_samples", args.emitterSamples}};
     info.wallSeconds = seconds;
     info.writePreviews = args.preview;
-    if (Status s = writeBakeOutputs(args.outDir, loaded->scene, loaded->layout, **baker, info); !s) return fail(s.message());
+    if (Status s = writeBakeOutputs(args.outDir, loaded->scene, loaded->layout, (*baker)->readLightmaps(),
+                                    (*baker)->stats().toJson(), info); !s) return fail(s.message());
     if (args.checkpointEvery > 0 || args.resume) std::filesystem::remove(checkpoint);  // the outputs supersede it
     logInfo("baked " + std::to_string(options.directions) + " directions in " + std::to_string(seconds) + " s -> " +
             args.outDir);

@@ -41,6 +41,8 @@ struct BakeArgs {
     bool resume = false;
     std::string rounding = "stochastic";
     float historyPower = -1.0f;
+    std::string direct = "auto";
+    int emitterSamples = 128;
     bool preview = true;
     bool progress = true;
 };
@@ -64,6 +66,10 @@ Expected<LoadedScene> loadSceneAndLayout(const SceneArgs& args);
 // callback stores the command's run function into `action`.
 void addInfoCommand(CLI::App& app, std::function<int()>& action);
 void addBakeCommand(CLI::App& app, std::function<int()>& action);
+void addImportanceCommand(CLI::App& app, std::function<int()>& action);  // importance_command.cpp
+void addRenderCommand(CLI::App& app, std::function<int()>& action);     // render_command.cpp
+void addReferenceCommand(CLI::App& app, std::function<int()>& action);  // reference_command.cpp
+void addCompareCommand(CLI::App& app, std::function<int()>& action);    // compare_command.cpp
 
 int runInfo(const InfoArgs& args);
 int runBake(const BakeArgs& args);
