@@ -704,10 +704,16 @@ void Baker::Impl::bakeDirection(int k) {
         },
         true);
     stats.updatedTexels += stats.coveredTexels;
-    auto tr = Clock::now();
-    resolveInto(true, radiance);
-    glFinish();
-    stats.secondsResolve += secondsSince(tr);
+    // Refresh the outgoing radiance the next bundles read. Every direction at
+    // first, when each one adds a bounce; later every k/32 directions (at most
+    // 8): the estimate then moves slowly and the resolve is a pass over every page.
+    const int interval = std::clamp(k / 32, 1, 8);
+    if ((k + 1) % interval == 0 || k + 1 == options.directions) {
+        auto tr = Clock::now();
+        resolveInto(true, radiance);
+        glFinish();
+        stats.secondsResolve += secondsSince(tr);
+    }
     ++stats.directionsDone;
 }
 
@@ -843,7 +849,7 @@ Baker::BundleCapture Baker::captureBundle(const glm::vec3& dir) {
 }
 
 namespace {
-constexpr char CHECKPOINT_MAGIC[8] = {'B', 'B', 'C', 'K', 'P', 'T', '0', '1'};
+constexpr char CHECKPOINT_MAGIC[8] = {'B', 'B', 'C', 'K', 'P', 'T', '0', '2'};
 
 uint64_t fnv1a(const void* data, size_t bytes, uint64_t h = 1469598103934665603ull) {
     const auto* p = static_cast<const uint8_t*>(data);
@@ -887,8 +893,12 @@ Status Baker::saveCheckpoint(const std::string& path) {
     h.resolution = res;
     h.pages = m.layout.pageCount;
     h.accumScale = m.accumScale;
+    // the radiance map too: it is refreshed on a schedule, so it can be older than the accumulators
+    std::vector<glm::vec4> radiance(raw.size());
+    glGetTextureImage(m.radiance.id(), 0, GL_RGBA, GL_FLOAT, GLsizei(radiance.size() * 16), radiance.data());
     std::string bytes(reinterpret_cast<const char*>(&h), sizeof h);
     bytes.append(reinterpret_cast<const char*>(raw.data()), raw.size() * sizeof(glm::uvec2));
+    bytes.append(reinterpret_cast<const char*>(radiance.data()), radiance.size() * sizeof(glm::vec4));
     return io::writeFileAtomic(path, bytes);
 }
 
@@ -899,9 +909,11 @@ Status Baker::loadCheckpoint(const std::string& path) {
     CheckpointHeader h{};
     const int res = m.layout.resolution;
     std::vector<glm::uvec2> raw(size_t(res) * res * m.layout.pageCount);
+    std::vector<glm::vec4> radiance(raw.size());
     bool ok = std::fread(&h, sizeof h, 1, f) == 1 && std::memcmp(h.magic, CHECKPOINT_MAGIC, 8) == 0 &&
               h.resolution == res && h.pages == m.layout.pageCount &&
-              std::fread(raw.data(), sizeof(glm::uvec2), raw.size(), f) == raw.size();
+              std::fread(raw.data(), sizeof(glm::uvec2), raw.size(), f) == raw.size() &&
+              std::fread(radiance.data(), sizeof(glm::vec4), radiance.size(), f) == radiance.size();
     std::fclose(f);
     if (!ok) return Status::error(path + " is not a bundlebake checkpoint of this layout");
     if (h.key != checkpointKey(m.mesh, m.layout, m.options, m.historyPower))
@@ -910,9 +922,9 @@ Status Baker::loadCheckpoint(const std::string& path) {
         return Status::error(path + ": corrupt progress count");
     glTextureSubImage3D(m.accum.id(), 0, 0, 0, 0, res, res, m.layout.pageCount, GL_RG_INTEGER, GL_UNSIGNED_INT,
                         raw.data());
+    glTextureSubImage3D(m.radiance.id(), 0, 0, 0, 0, res, res, m.layout.pageCount, GL_RGBA, GL_FLOAT, radiance.data());
     m.stats.directionsDone = h.directionsDone;
     m.accumScale = h.accumScale;
-    m.resolveInto(true, m.radiance);
     return Status::ok();
 }
 
