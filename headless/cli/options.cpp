@@ -90,16 +90,23 @@ Expected<LoadedScene> loadSceneAndLayout(const SceneArgs& a) {
 }
 
 int runInfo(const InfoArgs& args) {
-    auto loaded = loadSceneAndLayout(args.scene);
-    if (!loaded) return fail(loaded.error());
-    const Scene& s = loaded->scene;
-    const Layout& l = loaded->layout;
+    // the scene is described even when no layout can be made for it (no
+    // TEXCOORD_1): the layout lines then say why
+    auto albedo = parseColor(args.scene.defaultAlbedo, "--default-albedo");
+    if (!albedo) return fail(albedo.error());
+    LoadOptions lo;
+    lo.defaultAlbedo = *albedo;
+    auto scene = loadScene(args.scene.scene, lo);
+    if (!scene) return fail(scene.error());
+    LayoutOptions opts;
+    opts.mode = args.scene.uvLayout == "asset" ? UvLayout::Asset : UvLayout::Pack;
+    opts.resolution = args.scene.resolution;
+    opts.texelDensity = args.scene.texelDensity;
+    auto layout = computeLayout(*scene, opts);
+    const Scene& s = *scene;
     size_t emissiveMaterials = 0;
     for (const auto& m : s.materials)
         if (m.emission.r > 0 || m.emission.g > 0 || m.emission.b > 0) ++emissiveMaterials;
-    size_t coveredTexels = 0;
-    for (const auto& r : l.rects) coveredTexels += size_t(r.width) * r.height;
-    if (l.mode == UvLayout::Asset) coveredTexels = l.texelCount();
     glm::vec3 size = s.bounds.size();
     std::printf("scene        %s\n", s.path.c_str());
     std::printf("triangles    %zu (in %zu instances of %zu meshes)\n", s.triangleCount(), s.instances.size(), s.meshes.size());
@@ -119,6 +126,14 @@ int runInfo(const InfoArgs& args) {
                 s.bounds.min.x, s.bounds.min.y, s.bounds.min.z, s.bounds.max.x, s.bounds.max.y, s.bounds.max.z, size.x,
                 size.y, size.z);
     std::printf("uv1          %s\n", s.allHaveUv1() ? "present on every primitive" : "missing on some primitives");
+    if (!layout) {
+        std::printf("layout       none: %s\n", layout.error().c_str());
+        return 0;
+    }
+    const Layout& l = *layout;
+    size_t coveredTexels = 0;
+    for (const auto& r : l.rects) coveredTexels += size_t(r.width) * r.height;
+    if (l.mode == UvLayout::Asset) coveredTexels = l.texelCount();
     std::printf("layout       %s, %d page(s) of %dx%d texels, padding %d\n", l.mode == UvLayout::Asset ? "asset" : "pack",
                 l.pageCount, l.resolution, l.resolution, l.padding);
     if (l.mode == UvLayout::Pack) std::printf("density      %.6g texels per scene unit\n", l.texelDensity);
