@@ -34,10 +34,15 @@ std::string lightmapFileName(int page, const char* extension) {
     return name;
 }
 
-Status writeBakeOutputs(const std::string& outDir, const Scene& scene, const Layout& layout, Baker& baker,
-                        const BakeOutputInfo& info) {
+std::string coverageFileName(int page) {
+    char name[64];
+    std::snprintf(name, sizeof name, "coverage_%d.png", page);
+    return name;
+}
+
+Status writeBakeOutputs(const std::string& outDir, const Scene& scene, const Layout& layout, const LightmapPages& maps,
+                        nlohmann::json stats, const BakeOutputInfo& info) {
     if (Status s = io::ensureDirectory(outDir); !s) return s;
-    LightmapPages maps = baker.readLightmaps();
     const std::string units = "L_lm = E/pi (irradiance over pi), scene radiance units; row 0 = v 0 (glTF: v down from the top)";
     const float exposure = autoExposure(maps);
     nlohmann::json pages = nlohmann::json::array();
@@ -45,6 +50,16 @@ Status writeBakeOutputs(const std::string& outDir, const Scene& scene, const Lay
         std::string exr = lightmapFileName(int(p));
         if (Status s = io::writeExrHalf(outDir + "/" + exr, maps.pages[p], {{"bundlebake:units", units}}); !s) return s;
         nlohmann::json page = {{"page", p}, {"exr", exr}};
+        if (p < maps.covered.size()) {
+            io::ImageRgb mask;
+            mask.width = maps.pages[p].width;
+            mask.height = maps.pages[p].height;
+            mask.pixels.resize(maps.covered[p].size());
+            for (size_t i = 0; i < mask.pixels.size(); ++i) mask.pixels[i] = glm::vec3(maps.covered[p][i] ? 1.0f : 0.0f);
+            std::string png = coverageFileName(int(p));
+            if (Status s = io::writePng(outDir + "/" + png, mask, false); !s) return s;
+            page["coverage_png"] = png;
+        }
         if (info.writePreviews) {
             std::string png = lightmapFileName(int(p), "png");
             if (Status s = io::writePngToneMapped(outDir + "/" + png, maps.pages[p], exposure); !s) return s;
@@ -63,7 +78,7 @@ Status writeBakeOutputs(const std::string& outDir, const Scene& scene, const Lay
                              {"texel_density", r.texelDensity}});
     }
     nlohmann::json manifest = {
-        {"generator", "bundlebake"},
+        {"generator", info.generator},
         {"scene", scene.path},
         {"units", units},
         {"mapping", "page_uv = TEXCOORD_1 * uv1_scale + uv1_offset"},
@@ -76,12 +91,11 @@ Status writeBakeOutputs(const std::string& outDir, const Scene& scene, const Lay
     };
     if (Status s = io::writeJson(outDir + "/manifest.json", manifest); !s) return s;
 
-    nlohmann::json stats = baker.stats().toJson();
     stats["backend"] = info.backend;
     stats["renderer"] = info.renderer;
     stats["settings"] = info.settings;
     stats["wall_seconds"] = info.wallSeconds;
-    stats["scene"] = {{"path", scene.path}, {"triangles", baker.mesh().triangleCount()},
+    stats["scene"] = {{"path", scene.path}, {"triangles", scene.triangleCount()},
                       {"instances", scene.instances.size()}, {"lights", scene.lights.size()}};
     return io::writeJson(outDir + "/stats.json", stats);
 }

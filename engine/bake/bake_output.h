@@ -1,8 +1,10 @@
 // Writes a bake's outputs into a directory, each file atomically (temp name,
-// then rename): lightmap_<page>.exr (half RGB, L_lm = E/pi), manifest.json
-// (pages, instances with scale/offset, units), stats.json (BakeStats plus the
-// run's settings) and, optionally, lightmap_<page>.png tone-mapped previews.
-// Shared by the CLI and the viewer.
+// then rename): lightmap_<page>.exr (half RGB, L_lm = E/pi), coverage_<page>.png
+// (8-bit mask: 255 where LightmapPages::covered, 0 in padding and empty texels;
+// `bundlebake compare` reads it), manifest.json (pages, instances with
+// scale/offset, units), stats.json (the baker's figures plus the run's
+// settings) and, optionally, lightmap_<page>.png tone-mapped previews.
+// Shared by the CLI (bake, reference) and the viewer.
 #pragma once
 
 #include <string>
@@ -20,10 +22,17 @@ struct BakeOutputInfo {
     nlohmann::json settings;        // the flags of the run, echoed into stats.json
     double wallSeconds = 0;         // bake loop wall time
     bool writePreviews = true;
+    std::string generator = "bundlebake";  // manifest.json "generator" (e.g. "bundlebake reference")
 };
 
-Status writeBakeOutputs(const std::string& outDir, const Scene& scene, const Layout& layout, Baker& baker,
-                        const BakeOutputInfo& info);
+// `maps`: Baker::readLightmaps() or ReferenceBaker::readLightmaps(); `stats`: the
+// baker's figures (BakeStats::toJson(), ReferenceStats::toJson()), written to
+// stats.json with the run's info added.
+Status writeBakeOutputs(const std::string& outDir, const Scene& scene, const Layout& layout, const LightmapPages& maps,
+                        nlohmann::json stats, const BakeOutputInfo& info);
+
+// Coverage mask file name: "coverage_<page>.png".
+std::string coverageFileName(int page);
 
 // Page file name: "lightmap_<page>.exr".
 std::string lightmapFileName(int page, const char* extension = "exr");

@@ -74,7 +74,7 @@ struct ReferenceOptions {
     std::optional<io::ImageRgb> environment;  // equirectangular radiance; replaces sky
     bool emitterSampling = true;    // next-event estimation of emissive triangles (with MIS)
     int rouletteDepth = 3;          // bounces before Russian roulette starts; typ. 2..5
-    int maxBounces = 1000;          // safety cap (bias below 0.5^1000 for any albedo <= 0.5... negligible)
+    int maxBounces = 1000;          // safety cap on path length (roulette ends paths long before)
 };
 
 struct ReferenceStats {

@@ -22,6 +22,10 @@ int run(int argc, char** argv) {
     std::function<int()> action;
     addInfoCommand(app, action);
     addBakeCommand(app, action);
+    addImportanceCommand(app, action);
+    addRenderCommand(app, action);
+    addReferenceCommand(app, action);
+    addCompareCommand(app, action);
 
     try {
         app.parse(argc, argv);

@@ -115,21 +115,33 @@ inline std::string describe(const Summary& s, int resolution) {
     return buf;
 }
 
+// The baker's radiance-map refresh schedule (engine/bake/baker.cpp,
+// bakeDirection): after direction k (0-based) the outgoing radiance the next
+// bundles read is re-resolved when (k + 1) % clamp(k / 32, 1, 8) == 0 or k is
+// the last direction. Mirrored here for furnaceExpectation(); if the engine's
+// schedule changes, update this (it moves the rho 0.9 expectations by ~0.1%).
+inline bool radianceRefreshedAfter(int k, int directions) {
+    const int interval = std::clamp(k / 32, 1, 8);
+    return (k + 1) % interval == 0 || k + 1 == directions;
+}
+
 // The expected furnace value after N directions with the baker's history
 // ramp (BakeOptions::historyPower; direction k, 1-based, weighs
 // min(k, N/2)^p): L_lm is the weighted mean of the incoming radiance seen by
-// each direction, Le + rho * (the light map after the previous direction),
-// so M_k = sum_j w_j (Le + rho M_{j-1}) / sum_j w_j, M_0 = 0. This is the
-// bake's expectation in a furnace (every texel sees the same value); its gap
-// to Le / (1 - rho) is the start-up bias of the iteration.
+// each direction, Le + rho * R, R the light map as last resolved into the
+// radiance map (radianceRefreshedAfter), so
+//   M_k = sum_j w_j (Le + rho R_j) / sum_j w_j,  R_j = M at the last refresh before j.
+// This is the bake's expectation in a furnace (every texel sees the same
+// value); its gap to Le / (1 - rho) is the start-up bias of the iteration.
 inline double furnaceExpectation(double le, double rho, int directions, double historyPower) {
     const double rampEnd = std::max(1, directions / 2);
-    double sum = 0, weights = 0, m = 0;
+    double sum = 0, weights = 0, m = 0, r = 0;
     for (int k = 0; k < directions; ++k) {
         const double w = std::pow(std::min(double(k + 1), rampEnd), historyPower);
-        sum += w * (le + rho * m);
+        sum += w * (le + rho * r);
         weights += w;
         m = sum / weights;
+        if (radianceRefreshedAfter(k, directions)) r = m;
     }
     return m;
 }
@@ -200,6 +212,22 @@ inline glm::vec3 triangleCentroid(const BakeMesh& mesh, int t) {
     return glm::vec3(mesh.vertices[3 * size_t(t)].position + mesh.vertices[3 * size_t(t) + 1].position +
                      mesh.vertices[3 * size_t(t) + 2].position) /
            3.0f;
+}
+
+// World position of a texel centre, through the triangle that covers it
+// (barycentric coordinates in page UV; extrapolated if the centre is outside).
+inline glm::dvec3 texelWorldPoint(const BakeMesh& mesh, int resolution, int triangle, size_t texel) {
+    const size_t t = size_t(triangle);
+    glm::dvec2 p((double(texel % size_t(resolution)) + 0.5) / resolution,
+                 (double(texel / size_t(resolution)) + 0.5) / resolution);
+    glm::dvec2 a(mesh.vertices[3 * t].lightmapUv), b(mesh.vertices[3 * t + 1].lightmapUv),
+        c(mesh.vertices[3 * t + 2].lightmapUv);
+    double det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+    if (det == 0) return glm::dvec3(mesh.vertices[3 * t].position);
+    double l1 = ((p.x - a.x) * (c.y - a.y) - (c.x - a.x) * (p.y - a.y)) / det;
+    double l2 = ((b.x - a.x) * (p.y - a.y) - (p.x - a.x) * (b.y - a.y)) / det;
+    return (1 - l1 - l2) * glm::dvec3(mesh.vertices[3 * t].position) + l1 * glm::dvec3(mesh.vertices[3 * t + 1].position) +
+           l2 * glm::dvec3(mesh.vertices[3 * t + 2].position);
 }
 
 }  // namespace bb::test

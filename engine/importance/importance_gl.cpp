@@ -1,0 +1,237 @@
+// Importance analysis on the GPU (supplement §1): position buffer, I_max by
+// atomic max, Eq. (4) in a compute pass.
+//
+// Based on: Tokuyoshi, Sekine, da Silva, Kanai, "Adaptive Ray-bundle Tracing
+// with Memory Usage Prediction", CGF 32(7) 2013, supplement §1.
+#include "importance/importance_gl.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <cstddef>
+#include <string>
+
+#include "core/check.h"
+#include "gl/gl.h"
+#include "gl/shader.h"
+#include "glsl/shared/importance_layout.h"
+
+namespace bb {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// The compute pass reads BakeVertex as the std430 struct ImportanceVertex.
+static_assert(sizeof(BakeVertex) == 48);
+static_assert(offsetof(BakeVertex, position) == 0);
+static_assert(offsetof(BakeVertex, lightmapUv) == 40);
+static_assert(float(IMPORTANCE_MAX_AREA_RATIO) == MAX_AREA_RATIO);
+
+}  // namespace
+
+Expected<std::unique_ptr<ImportanceAnalyzer>> ImportanceAnalyzer::create() {
+    std::unique_ptr<ImportanceAnalyzer> a(new ImportanceAnalyzer());
+    struct Spec {
+        gl::Program* target;
+        std::vector<std::string> files;
+    } specs[] = {
+        {&a->positionProgram_, {"importance/lightmap.vert", "importance/position.frag"}},
+        {&a->maxDensityProgram_, {"importance/lightmap.vert", "importance/imax.frag"}},
+        {&a->clampProgram_, {"importance/clamp.comp"}},
+    };
+    for (auto& s : specs) {
+        auto p = gl::buildProgram(s.files);
+        if (!p) return p.status();
+        *s.target = std::move(p.value());
+    }
+    GLint bits = 0;
+    glGetIntegerv(GL_SUBPIXEL_BITS, &bits);
+    if (bits > 0) a->rules_.subpixelBits = bits;
+    return a;
+}
+
+Expected<ImportanceGlResult> ImportanceAnalyzer::analyze(const BakeMesh& mesh, int resolution,
+                                                        const ImportanceCapture& capture) {
+    CHECK(!mesh.pageFirstTriangle.empty());
+    CHECK_EQ(mesh.vertices.size(), mesh.triangles.size() * 3);
+    const int pageCount = int(mesh.pageFirstTriangle.size()) - 1;
+    const size_t n = mesh.triangles.size();
+    ImportanceGlResult result;
+
+    // limits (read, not assumed)
+    GLint maxTex = 0, vp[2] = {0, 0}, maxFbW = 0, maxFbH = 0, ssboAlign = 1;
+    GLint64 maxSsbo = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &maxTex);
+    glGetIntegerv(GL_MAX_VIEWPORT_DIMS, vp);
+    glGetIntegerv(GL_MAX_FRAMEBUFFER_WIDTH, &maxFbW);
+    glGetIntegerv(GL_MAX_FRAMEBUFFER_HEIGHT, &maxFbH);
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxSsbo);
+    glGetIntegerv(GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT, &ssboAlign);
+    const int maxSide = std::min({maxTex, vp[0], vp[1], maxFbW, maxFbH});
+    if (resolution < 1 || resolution > maxSide)
+        return Status::error("light map resolution " + std::to_string(resolution) +
+                             " exceeds this GL's texture/viewport/framebuffer limit " + std::to_string(maxSide));
+    if (int64_t(n) * 4 > maxSsbo)
+        return Status::error(std::to_string(n) + " triangles exceed GL_MAX_SHADER_STORAGE_BLOCK_SIZE (" +
+                             std::to_string(maxSsbo) + " bytes) for the per-triangle I_max buffer");
+    if (capture.positionBuffers && int64_t(resolution) * resolution * 16 > int64_t(INT32_MAX))
+        return Status::error("capturing the position buffer of a " + std::to_string(resolution) +
+                             "^2 page exceeds one 2 GiB read-back");
+    if (n == 0) return result;
+
+    gl::DebugGroup group("importance analysis");
+    auto tu = Clock::now();
+    // upload: the bake vertices (vertex attributes for passes 1-2, an SSBO for pass 3)
+    gl::Buffer vertices = gl::Buffer::create("importance vertices", int64_t(mesh.vertices.size() * sizeof(BakeVertex)),
+                                             mesh.vertices.data(), 0);
+    gl::VertexArray vao = gl::VertexArray::create("importance vertex array");
+    glVertexArrayVertexBuffer(vao.id(), 0, vertices.id(), 0, sizeof(BakeVertex));
+    const GLuint sizes[] = {4, 4, 2, 2};
+    const GLuint offsets[] = {offsetof(BakeVertex, position), offsetof(BakeVertex, normal), offsetof(BakeVertex, uv0),
+                              offsetof(BakeVertex, lightmapUv)};
+    for (GLuint a = 0; a < 4; ++a) {
+        glEnableVertexArrayAttrib(vao.id(), a);
+        glVertexArrayAttribFormat(vao.id(), a, sizes[a], GL_FLOAT, GL_FALSE, offsets[a]);
+        glVertexArrayAttribBinding(vao.id(), a, 0);
+    }
+    const int64_t perTriangleBytes = int64_t(n) * 4;
+    gl::Buffer maxDensity = gl::Buffer::create("importance I_max(t) bits", perTriangleBytes, nullptr, 0);
+    const uint32_t zero = 0;
+    glClearNamedBufferData(maxDensity.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);  // I_max = 0.0f
+    importance_ = gl::Buffer::create("importance I(t)", perTriangleBytes, nullptr, 0);
+    gl::Buffer ratio = gl::Buffer::create("importance A_l/A_o", perTriangleBytes, nullptr, 0);
+
+    gl::Texture positions = gl::Texture::create2D("importance position buffer", GL_RGBA32F, resolution, resolution);
+    gl::Texture triangles = gl::Texture::create2D("importance triangle buffer", GL_R32UI, resolution, resolution);
+    gl::Texture density;
+    if (capture.texelDensity) density = gl::Texture::create2D("importance texel density", GL_R32F, resolution, resolution);
+    gl::Framebuffer positionFbo = gl::Framebuffer::create("importance position framebuffer");
+    glNamedFramebufferTexture(positionFbo.id(), GL_COLOR_ATTACHMENT0 + IMPORTANCE_OUT_POSITION, positions.id(), 0);
+    glNamedFramebufferTexture(positionFbo.id(), GL_COLOR_ATTACHMENT0 + IMPORTANCE_OUT_TRIANGLE, triangles.id(), 0);
+    const GLenum drawBuffers[] = {GL_COLOR_ATTACHMENT0 + IMPORTANCE_OUT_POSITION,
+                                  GL_COLOR_ATTACHMENT0 + IMPORTANCE_OUT_TRIANGLE};
+    glNamedFramebufferDrawBuffers(positionFbo.id(), 2, drawBuffers);
+    CHECK_EQ(glCheckNamedFramebufferStatus(positionFbo.id(), GL_FRAMEBUFFER), GLenum(GL_FRAMEBUFFER_COMPLETE));
+    // pass 2 reads the position buffer, so it draws into a framebuffer without attachments
+    gl::Framebuffer emptyFbo = gl::Framebuffer::create("importance I_max framebuffer (no attachments)");
+    glNamedFramebufferParameteri(emptyFbo.id(), GL_FRAMEBUFFER_DEFAULT_WIDTH, resolution);
+    glNamedFramebufferParameteri(emptyFbo.id(), GL_FRAMEBUFFER_DEFAULT_HEIGHT, resolution);
+    CHECK_EQ(glCheckNamedFramebufferStatus(emptyFbo.id(), GL_FRAMEBUFFER), GLenum(GL_FRAMEBUFFER_COMPLETE));
+    glFinish();
+    result.seconds.upload = secondsSince(tu);
+
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);  // both windings: UV charts may be mirrored
+    glDisable(GL_BLEND);
+    glDisable(GL_SCISSOR_TEST);
+    glViewport(0, 0, resolution, resolution);
+    glBindVertexArray(vao.id());
+    const size_t texels = size_t(resolution) * resolution;
+    for (int page = 0; page < pageCount; ++page) {
+        const uint32_t first = mesh.pageFirstTriangle[size_t(page)], last = mesh.pageFirstTriangle[size_t(page) + 1];
+        if (first == last && !capture.texelTriangles && !capture.positionBuffers && !capture.texelDensity) continue;
+        auto t1 = Clock::now();
+        {
+            gl::DebugGroup pass("importance position pass");
+            glBindFramebuffer(GL_FRAMEBUFFER, positionFbo.id());
+            const float zeroF[4] = {0, 0, 0, 0};
+            const GLuint zeroU[4] = {0, 0, 0, 0};
+            glClearBufferfv(GL_COLOR, IMPORTANCE_OUT_POSITION, zeroF);
+            glClearBufferuiv(GL_COLOR, IMPORTANCE_OUT_TRIANGLE, zeroU);
+            glUseProgram(positionProgram_.id());
+            if (last > first) glDrawArrays(GL_TRIANGLES, GLint(first * 3), GLsizei((last - first) * 3));
+            glFinish();
+        }
+        result.seconds.positionPass += secondsSince(t1);
+        auto t2 = Clock::now();
+        {
+            gl::DebugGroup pass("importance I_max pass");
+            glBindFramebuffer(GL_FRAMEBUFFER, emptyFbo.id());
+            glUseProgram(maxDensityProgram_.id());
+            glUniform1i(maxDensityProgram_.uniform("resolution"), resolution);
+            glUniform1i(maxDensityProgram_.uniform("writeDensity"), capture.texelDensity ? 1 : 0);
+            glBindImageTexture(IMPORTANCE_IMAGE_POSITIONS, positions.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+            glBindImageTexture(IMPORTANCE_IMAGE_TRIANGLES, triangles.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IMPORTANCE_BINDING_MAX_DENSITY, maxDensity.id());
+            if (capture.texelDensity) {
+                const float zeroF = 0.0f;
+                glClearTexImage(density.id(), 0, GL_RED, GL_FLOAT, &zeroF);
+                glBindImageTexture(IMPORTANCE_IMAGE_DENSITY, density.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+            }
+            if (last > first) glDrawArrays(GL_TRIANGLES, GLint(first * 3), GLsizei((last - first) * 3));
+            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT |
+                            GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+            glFinish();
+        }
+        result.seconds.maxDensityPass += secondsSince(t2);
+        auto tr = Clock::now();
+        if (capture.texelTriangles || capture.positionBuffers) {
+            std::vector<uint32_t> ids(texels);
+            glGetTextureImage(triangles.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, GLsizei(texels * 4), ids.data());
+            if (capture.positionBuffers) {
+                std::vector<glm::vec4> p(texels);
+                glGetTextureImage(positions.id(), 0, GL_RGBA, GL_FLOAT, GLsizei(texels * 16), p.data());
+                PositionBuffer buffer;
+                buffer.resolution = resolution;
+                buffer.texels.resize(texels);
+                for (size_t i = 0; i < texels; ++i) buffer.texels[i] = PositionTexel{glm::vec3(p[i]), ids[i]};
+                result.positionBuffers.push_back(std::move(buffer));
+            }
+            if (capture.texelTriangles) result.texelTriangles.push_back(std::move(ids));
+        }
+        if (capture.texelDensity) {
+            std::vector<float> d(texels);
+            glGetTextureImage(density.id(), 0, GL_RED, GL_FLOAT, GLsizei(texels * 4), d.data());
+            result.texelDensity.push_back(std::move(d));
+        }
+        result.seconds.readback += secondsSince(tr);
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+
+    // pass 3: Eq. (4), in chunks so that every bound range fits the SSBO size
+    // limit and the dispatch limit; a chunk is a multiple of the group size,
+    // so its offsets are multiples of 64 * 4 and 64 * 144 bytes
+    auto t3 = Clock::now();
+    {
+        gl::DebugGroup pass("importance clamp pass");
+        GLint maxGroups = 0;
+        glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0, &maxGroups);
+        const int64_t bytesPerTriangle = 3 * int64_t(sizeof(BakeVertex));
+        int64_t chunk = std::min<int64_t>(int64_t(maxGroups) * IMPORTANCE_GROUP_SIZE, maxSsbo / bytesPerTriangle);
+        chunk = std::max<int64_t>(IMPORTANCE_GROUP_SIZE, chunk / IMPORTANCE_GROUP_SIZE * IMPORTANCE_GROUP_SIZE);
+        CHECK_EQ((chunk * 4) % ssboAlign, 0);
+        glUseProgram(clampProgram_.id());
+        glUniform1f(clampProgram_.uniform("resolution"), float(resolution));
+        for (int64_t base = 0; base < int64_t(n); base += chunk) {
+            const int64_t count = std::min<int64_t>(chunk, int64_t(n) - base);
+            glBindBufferRange(GL_SHADER_STORAGE_BUFFER, IMPORTANCE_BINDING_VERTICES, vertices.id(),
+                              base * bytesPerTriangle, count * bytesPerTriangle);
+            glBindBufferRange(GL_SHADER_STORAGE_BUFFER, IMPORTANCE_BINDING_MAX_DENSITY, maxDensity.id(), base * 4,
+                              count * 4);
+            glBindBufferRange(GL_SHADER_STORAGE_BUFFER, IMPORTANCE_BINDING_IMPORTANCE, importance_.id(), base * 4,
+                              count * 4);
+            glBindBufferRange(GL_SHADER_STORAGE_BUFFER, IMPORTANCE_BINDING_AREA_RATIO, ratio.id(), base * 4, count * 4);
+            glUniform1ui(clampProgram_.uniform("triangleCount"), GLuint(count));
+            glDispatchCompute(GLuint((count + IMPORTANCE_GROUP_SIZE - 1) / IMPORTANCE_GROUP_SIZE), 1, 1);
+        }
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+        glFinish();
+    }
+    result.seconds.computePass = secondsSince(t3);
+
+    auto tr = Clock::now();
+    Importance& out = result.importance;
+    out.importance.resize(n);
+    out.areaRatio.resize(n);
+    out.maxDensity.resize(n);
+    glGetNamedBufferSubData(importance_.id(), 0, perTriangleBytes, out.importance.data());
+    glGetNamedBufferSubData(ratio.id(), 0, perTriangleBytes, out.areaRatio.data());
+    glGetNamedBufferSubData(maxDensity.id(), 0, perTriangleBytes, out.maxDensity.data());  // float bits
+    result.seconds.readback += secondsSince(tr);
+    glBindVertexArray(0);
+    glUseProgram(0);
+    return result;
+}
+
+}  // namespace bb

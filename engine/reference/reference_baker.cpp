@@ -1,0 +1,721 @@
+// CPU reference baker: path tracing from light map texel centres on Embree 3.
+// See reference_baker.h for the model and the sampling; the notes here are
+// about how.
+#include "reference/reference_baker.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <thread>
+
+#include <embree3/rtcore.h>
+#if defined(__SSE__) || defined(__x86_64__)
+#include <pmmintrin.h>
+#include <xmmintrin.h>
+#define BB_HAVE_SSE_FTZ 1
+#endif
+
+#include "core/check.h"
+#include "core/log.h"
+
+namespace bb {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+constexpr float PI = 3.14159265358979323846f;
+constexpr float INV_PI = 1.0f / PI;
+
+// --- random numbers -----------------------------------------------------------
+
+uint64_t mix64(uint64_t x) {  // splitmix64 finalizer
+    x += 0x9E3779B97F4A7C15ull;
+    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+    x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+    return x ^ (x >> 31);
+}
+uint64_t hash(uint64_t a, uint64_t b) { return mix64(a ^ mix64(b)); }
+uint64_t hash(uint64_t a, uint64_t b, uint64_t c) { return hash(hash(a, b), c); }
+
+// PCG32 (O'Neill 2014), one stream per (texel, sample).
+struct Pcg32 {
+    uint64_t state = 0, inc = 1;
+    explicit Pcg32(uint64_t seed) : state(0), inc((mix64(seed ^ 0x5851F42D4C957F2Dull) << 1) | 1u) {
+        next();
+        state += mix64(seed);
+        next();
+    }
+    uint32_t next() {
+        uint64_t old = state;
+        state = old * 6364136223846793005ull + inc;
+        uint32_t xorshifted = uint32_t(((old >> 18u) ^ old) >> 27u);
+        uint32_t rot = uint32_t(old >> 59u);
+        return (xorshifted >> rot) | (xorshifted << ((32u - rot) & 31u));
+    }
+    float uniform() { return std::min(float(next()) * 0x1p-32f, 0x1.fffffep-1f); }
+};
+
+uint32_t reverseBits(uint32_t v) {
+    v = ((v >> 1) & 0x55555555u) | ((v & 0x55555555u) << 1);
+    v = ((v >> 2) & 0x33333333u) | ((v & 0x33333333u) << 2);
+    v = ((v >> 4) & 0x0F0F0F0Fu) | ((v & 0x0F0F0F0Fu) << 4);
+    v = ((v >> 8) & 0x00FF00FFu) | ((v & 0x00FF00FFu) << 8);
+    return (v >> 16) | (v << 16);
+}
+// The first two Sobol' dimensions (a (0,2)-sequence), as 0.32 fixed point.
+uint32_t sobol0(uint32_t i) { return reverseBits(i); }
+uint32_t sobol1(uint32_t i) {
+    uint32_t r = 0;
+    for (uint32_t v = 1u << 31; i; i >>= 1, v ^= v >> 1)
+        if (i & 1u) r ^= v;
+    return r;
+}
+// Owen scrambling by hashing (Laine and Karras 2011; constants of pbrt-v4's FastOwenScrambler).
+uint32_t owenScramble(uint32_t v, uint32_t seed) {
+    v = reverseBits(v);
+    v ^= v * 0x3d20adeau;
+    v += seed;
+    v *= (seed >> 16) | 1u;
+    v ^= v * 0x05526c56u;
+    v ^= v * 0x53a22864u;
+    return reverseBits(v);
+}
+float unit(uint32_t v) { return std::min(float(v) * 0x1p-32f, 0x1.fffffep-1f); }
+
+// Per-texel scrambles of the low-discrepancy dimensions (first vertex only).
+struct Scrambles {
+    uint32_t dir0, dir1, light0, light1;
+};
+Scrambles makeScrambles(uint64_t key) {
+    uint64_t a = hash(key, 0xA11CEull), b = hash(key, 0xB0Bull);
+    return {uint32_t(a), uint32_t(a >> 32), uint32_t(b), uint32_t(b >> 32)};
+}
+
+// --- sampling -----------------------------------------------------------------
+
+// Shirley-Chiu concentric map, then Malley's method: pdf = cos / pi.
+glm::vec3 cosineHemisphere(float u1, float u2) {
+    float a = 2.0f * u1 - 1.0f, b = 2.0f * u2 - 1.0f;
+    float r = 0.0f, phi = 0.0f;
+    if (a != 0.0f || b != 0.0f) {
+        if (std::fabs(a) > std::fabs(b)) {
+            r = a;
+            phi = (PI / 4.0f) * (b / a);
+        } else {
+            r = b;
+            phi = PI / 2.0f - (PI / 4.0f) * (a / b);
+        }
+    }
+    float x = r * std::cos(phi), y = r * std::sin(phi);
+    return {x, y, std::sqrt(std::max(0.0f, 1.0f - x * x - y * y))};
+}
+
+// Duff et al. 2017, "Building an Orthonormal Basis, Revisited".
+void basis(const glm::vec3& n, glm::vec3& t, glm::vec3& b) {
+    float s = std::copysign(1.0f, n.z);
+    float a = -1.0f / (s + n.z);
+    float c = n.x * n.y * a;
+    t = glm::vec3(1.0f + s * n.x * n.x * a, s * c, -s * n.x);
+    b = glm::vec3(c, s + n.y * n.y * a, -n.y);
+}
+
+float maxComponent(const glm::vec3& v) { return std::max({v.x, v.y, v.z}); }
+
+// Bilinear, repeating, level 0; texels row 0 = v 0 (glTF), as GL samples the uploaded image.
+glm::vec3 sampleTexture(const Texture& t, glm::vec2 uv) {
+    if (t.width <= 0 || t.height <= 0) return glm::vec3(1.0f);
+    float x = uv.x * float(t.width) - 0.5f, y = uv.y * float(t.height) - 0.5f;
+    if (!std::isfinite(x) || !std::isfinite(y)) return glm::vec3(t.texels[0]);
+    float fx0 = std::floor(x), fy0 = std::floor(y);
+    float fx = x - fx0, fy = y - fy0;
+    auto wrap = [](int64_t i, int n) { return int((i % n + n) % n); };
+    int x0 = wrap(int64_t(fx0), t.width), x1 = wrap(int64_t(fx0) + 1, t.width);
+    int y0 = wrap(int64_t(fy0), t.height), y1 = wrap(int64_t(fy0) + 1, t.height);
+    auto at = [&](int px, int py) { return glm::vec3(t.texels[size_t(py) * t.width + px]); };
+    return glm::mix(glm::mix(at(x0, y0), at(x1, y0), fx), glm::mix(at(x0, y1), at(x1, y1), fx), fy);
+}
+
+// A point being lit: the side of its surface that `ns` (shading) faces, `ng`
+// the geometric normal turned to that side.
+struct SurfacePoint {
+    glm::vec3 p{0.0f}, ns{0.0f, 1.0f, 0.0f}, ng{0.0f, 1.0f, 0.0f};
+};
+
+struct Counters {
+    int64_t paths = 0, rays = 0, shadowRays = 0;
+};
+
+struct Texel {
+    uint32_t page = 0;
+    uint32_t index = 0;  // y * resolution + x
+    SurfacePoint point;
+};
+
+}  // namespace
+
+nlohmann::json ReferenceStats::toJson() const {
+    nlohmann::json j;
+    j["spp"] = sppDone;
+    j["spp_total"] = sppTotal;
+    j["threads"] = threads;
+    j["passes"] = passes;
+    j["lightmap"] = {{"texels", lightmapTexels}, {"covered_texels", coveredTexels}};
+    j["emitter_triangles"] = emitterTriangles;
+    j["paths"] = paths;
+    j["rays"] = rays;
+    j["shadow_rays"] = shadowRays;
+    double total = double(rays + shadowRays);
+    j["rays_per_second"] = secondsTrace > 0 ? total / secondsTrace : 0.0;
+    j["seconds"] = {{"setup", secondsSetup}, {"trace", secondsTrace}, {"total", secondsSetup + secondsTrace}};
+    return j;
+}
+
+struct ReferenceBaker::Impl {
+    ReferenceOptions options;
+    Layout layout;
+    BakeMesh mesh;
+    std::vector<Material> materials;
+    std::vector<Texture> textures;
+    std::vector<DirectionalLight> lights;
+    ReferenceStats stats;
+
+    std::vector<glm::vec3> triNormal;     // geometric, unit, counter-clockwise front
+    std::vector<float> lightPdfArea;      // per triangle: P(pick it) / its area (0: not sampled)
+    std::vector<uint32_t> emitters;       // emissive triangles
+    std::vector<float> emitterCdf;        // over emitters, by area x mean emission factor
+    float eps = 1e-5f;                    // ray offset off surfaces, scene units
+
+    std::vector<Texel> texels;
+    std::vector<glm::dvec3> sums;         // per texel, over the samples done
+
+    RTCDevice device = nullptr;
+    RTCScene rtcScene = nullptr;
+
+    ~Impl() {
+        if (rtcScene) rtcReleaseScene(rtcScene);
+        if (device) rtcReleaseDevice(device);
+    }
+
+    Status init(const Scene& scene);
+    void findTexels();
+    void runPass(int first, int count);
+    glm::vec3 sample(const SurfacePoint& start, uint32_t sampleIndex, uint64_t key, const Scrambles& s,
+                     Counters& counters) const;
+
+    bool intersect(const glm::vec3& origin, const glm::vec3& dir, RTCRayHit& rh) const;
+    bool occluded(const glm::vec3& origin, const glm::vec3& dir, float tfar) const;
+    glm::vec3 environment(const glm::vec3& dir) const;
+    glm::vec3 albedoAt(const Material& m, glm::vec2 uv0) const;
+    glm::vec3 emissionAt(const Material& m, glm::vec2 uv0) const;
+    glm::vec3 directLight(const SurfacePoint& x, const glm::vec3& beta, float u1, float u2, Counters& counters) const;
+};
+
+void embreeError(void*, RTCError code, const char* message) {
+    logError(std::string("embree: error ") + std::to_string(int(code)) + ": " + (message ? message : ""));
+}
+
+Status ReferenceBaker::Impl::init(const Scene& scene) {
+    auto t0 = Clock::now();
+    if (options.spp < 1) return Status::error("--spp must be at least 1");
+    if (options.passSpp < 1) return Status::error("the pass size must be at least 1 sample");
+    if (options.threads < 0) return Status::error("--threads must be >= 0");
+    if (options.rouletteDepth < 1 || options.maxBounces < 1)
+        return Status::error("roulette depth and bounce cap must be at least 1");
+    if (mesh.triangles.empty()) return Status::error("nothing to bake: the scene has no triangles");
+    if (options.threads == 0) options.threads = int(std::max(1u, std::thread::hardware_concurrency()));
+    materials = scene.materials;
+    textures = scene.textures;
+    lights = scene.lights;
+    stats.sppTotal = options.spp;
+    stats.threads = options.threads;
+    stats.lightmapTexels = int64_t(layout.texelCount());
+
+    // offsets: a few hundred float ulps at the scene's largest coordinate
+    float extent = std::max({std::fabs(mesh.bounds.min.x), std::fabs(mesh.bounds.min.y), std::fabs(mesh.bounds.min.z),
+                             std::fabs(mesh.bounds.max.x), std::fabs(mesh.bounds.max.y), std::fabs(mesh.bounds.max.z),
+                             glm::length(mesh.bounds.size())});
+    eps = std::max(2e-5f * extent, 1e-7f);
+
+    // triangles: geometric normals and the emitter distribution
+    const size_t n = mesh.triangles.size();
+    triNormal.resize(n);
+    lightPdfArea.assign(n, 0.0f);
+    std::vector<float> area(n);
+    for (size_t t = 0; t < n; ++t) {
+        const glm::vec3 a(mesh.vertices[3 * t].position), b(mesh.vertices[3 * t + 1].position),
+            c(mesh.vertices[3 * t + 2].position);
+        glm::vec3 cr = glm::cross(b - a, c - a);
+        float len = glm::length(cr);
+        area[t] = 0.5f * len;
+        triNormal[t] = len > 0.0f ? cr / len : glm::vec3(0.0f);
+    }
+    double total = 0.0;
+    for (size_t t = 0; t < n; ++t) {
+        const Material& m = materials[mesh.triangles[t].material];
+        float power = (m.emission.r + m.emission.g + m.emission.b) / 3.0f * area[t];
+        if (power > 0.0f && area[t] > 0.0f) {
+            emitters.push_back(uint32_t(t));
+            total += power;
+            emitterCdf.push_back(float(total));
+        }
+    }
+    for (size_t k = 0; k < emitters.size(); ++k) {
+        emitterCdf[k] = float(emitterCdf[k] / total);
+        const Material& m = materials[mesh.triangles[emitters[k]].material];
+        lightPdfArea[emitters[k]] = float((m.emission.r + m.emission.g + m.emission.b) / 3.0 / total);
+    }
+    if (!emitterCdf.empty()) emitterCdf.back() = 1.0f;
+    stats.emitterTriangles = int64_t(emitters.size());
+
+    // BVH
+    std::string config = "threads=" + std::to_string(options.threads);
+    device = rtcNewDevice(config.c_str());
+    if (!device) return Status::error("embree: cannot create a device (error " + std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
+    rtcSetDeviceErrorFunction(device, embreeError, nullptr);
+    rtcScene = rtcNewScene(device);
+    rtcSetSceneFlags(rtcScene, RTC_SCENE_FLAG_ROBUST);  // watertight: no leaks through shared edges
+    rtcSetSceneBuildQuality(rtcScene, RTC_BUILD_QUALITY_HIGH);
+    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vb = static_cast<float*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * n));
+    auto* ib = static_cast<uint32_t*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), n));
+    if (!vb || !ib) return Status::error("embree: cannot allocate the geometry buffers");
+    for (size_t i = 0; i < 3 * n; ++i) {
+        vb[3 * i] = mesh.vertices[i].position.x;
+        vb[3 * i + 1] = mesh.vertices[i].position.y;
+        vb[3 * i + 2] = mesh.vertices[i].position.z;
+        ib[i] = uint32_t(i);
+    }
+    rtcCommitGeometry(geom);
+    rtcAttachGeometry(rtcScene, geom);
+    rtcReleaseGeometry(geom);
+    rtcCommitScene(rtcScene);
+    if (RTCError e = rtcGetDeviceError(device); e != RTC_ERROR_NONE)
+        return Status::error("embree: scene build failed (error " + std::to_string(int(e)) + ")");
+
+    findTexels();
+    sums.assign(texels.size(), glm::dvec3(0.0));
+    stats.coveredTexels = int64_t(texels.size());
+    stats.secondsSetup = secondsSince(t0);
+    return Status::ok();
+}
+
+// Coverage: texel centres inside triangles in page space. The triangles of a
+// page are visited in the GPU meta pass's order (stable by material), the last
+// one covering a centre owns it, as with GL's draw order and no depth test.
+void ReferenceBaker::Impl::findTexels() {
+    const int res = layout.resolution;
+    for (int page = 0; page < layout.pageCount; ++page) {
+        std::vector<uint32_t> order;
+        for (uint32_t t = mesh.pageFirstTriangle[page]; t < mesh.pageFirstTriangle[page + 1]; ++t) order.push_back(t);
+        std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+            return mesh.triangles[a].material < mesh.triangles[b].material;
+        });
+        std::vector<int64_t> owner(size_t(res) * res, -1);
+        std::vector<glm::dvec3> weights(size_t(res) * res);
+        for (uint32_t t : order) {
+            glm::dvec2 q[3];
+            for (int k = 0; k < 3; ++k) q[k] = glm::dvec2(mesh.vertices[3 * t + k].lightmapUv) * double(res);
+            double area2 = (q[1].x - q[0].x) * (q[2].y - q[0].y) - (q[1].y - q[0].y) * (q[2].x - q[0].x);
+            if (area2 == 0.0 || !std::isfinite(area2)) continue;
+            // counter-clockwise vertex order for the tie rule; weights follow the vertices
+            int idx[3] = {0, 1, 2};
+            if (area2 < 0) std::swap(idx[1], idx[2]);
+            const double absArea = std::fabs(area2);
+            // top-left rule (y up, counter-clockwise): an edge going down is a left
+            // edge, a horizontal edge going left is a top edge; centres on them count
+            bool topLeft[3];
+            for (int e = 0; e < 3; ++e) {
+                const glm::dvec2 a = q[idx[(e + 1) % 3]], b = q[idx[(e + 2) % 3]];  // edge opposite vertex e
+                topLeft[e] = (b.y < a.y) || (b.y == a.y && b.x < a.x);
+            }
+            double minX = std::min({q[0].x, q[1].x, q[2].x}), maxX = std::max({q[0].x, q[1].x, q[2].x});
+            double minY = std::min({q[0].y, q[1].y, q[2].y}), maxY = std::max({q[0].y, q[1].y, q[2].y});
+            int x0 = std::max(0, int(std::floor(minX - 0.5))), x1 = std::min(res - 1, int(std::ceil(maxX - 0.5)));
+            int y0 = std::max(0, int(std::floor(minY - 0.5))), y1 = std::min(res - 1, int(std::ceil(maxY - 0.5)));
+            for (int y = y0; y <= y1; ++y)
+                for (int x = x0; x <= x1; ++x) {
+                    const glm::dvec2 c(x + 0.5, y + 0.5);
+                    double w[3];
+                    bool inside = true;
+                    for (int e = 0; e < 3 && inside; ++e) {
+                        const glm::dvec2 a = q[idx[(e + 1) % 3]], b = q[idx[(e + 2) % 3]];
+                        w[e] = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+                        inside = w[e] > 0.0 || (w[e] == 0.0 && topLeft[e]);
+                    }
+                    if (!inside) continue;
+                    glm::dvec3 bary;
+                    for (int e = 0; e < 3; ++e) bary[idx[e]] = w[e] / absArea;
+                    owner[size_t(y) * res + x] = t;
+                    weights[size_t(y) * res + x] = bary;
+                }
+        }
+        for (size_t i = 0; i < owner.size(); ++i) {
+            if (owner[i] < 0) continue;
+            const size_t t = size_t(owner[i]);
+            const glm::dvec3 w = weights[i];
+            const BakeVertex* v = &mesh.vertices[3 * t];
+            Texel texel;
+            texel.page = uint32_t(page);
+            texel.index = uint32_t(i);
+            texel.point.p = glm::vec3(w.x * glm::dvec3(v[0].position) + w.y * glm::dvec3(v[1].position) +
+                                      w.z * glm::dvec3(v[2].position));
+            glm::vec3 ns = glm::vec3(w.x * glm::dvec3(v[0].normal) + w.y * glm::dvec3(v[1].normal) +
+                                     w.z * glm::dvec3(v[2].normal));
+            const glm::vec3 ng = triNormal[t];
+            float len = glm::length(ns);
+            ns = len > 0.0f && std::isfinite(len) ? ns / len : ng;
+            texel.point.ns = ns;
+            // the geometric normal on the side the texel looks at
+            texel.point.ng = glm::dot(ns, ng) >= 0.0f ? ng : -ng;
+            texels.push_back(texel);
+        }
+    }
+}
+
+bool ReferenceBaker::Impl::intersect(const glm::vec3& origin, const glm::vec3& dir, RTCRayHit& rh) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    rh.ray.org_x = origin.x;
+    rh.ray.org_y = origin.y;
+    rh.ray.org_z = origin.z;
+    rh.ray.dir_x = dir.x;
+    rh.ray.dir_y = dir.y;
+    rh.ray.dir_z = dir.z;
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = std::numeric_limits<float>::infinity();
+    rh.ray.time = 0.0f;
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(rtcScene, &context, &rh);
+    return rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+}
+
+bool ReferenceBaker::Impl::occluded(const glm::vec3& origin, const glm::vec3& dir, float tfar) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRay ray;
+    ray.org_x = origin.x;
+    ray.org_y = origin.y;
+    ray.org_z = origin.z;
+    ray.dir_x = dir.x;
+    ray.dir_y = dir.y;
+    ray.dir_z = dir.z;
+    ray.tnear = 0.0f;
+    ray.tfar = tfar;
+    ray.time = 0.0f;
+    ray.mask = 0xFFFFFFFFu;
+    ray.id = 0;
+    ray.flags = 0;
+    rtcOccluded1(rtcScene, &context, &ray);
+    return ray.tfar < 0.0f;  // set to -inf on a hit
+}
+
+glm::vec3 ReferenceBaker::Impl::environment(const glm::vec3& dir) const {
+    if (!options.environment) return options.sky;
+    const io::ImageRgb& env = *options.environment;
+    if (env.width <= 0 || env.height <= 0) return glm::vec3(0.0f);
+    float u = 0.5f + std::atan2(dir.z, dir.x) / (2.0f * PI);
+    float v = std::acos(std::clamp(dir.y, -1.0f, 1.0f)) / PI;
+    float x = u * float(env.width) - 0.5f, y = std::clamp(v * float(env.height) - 0.5f, 0.0f, float(env.height - 1));
+    float fx0 = std::floor(x), fy0 = std::floor(y);
+    float fx = x - fx0, fy = y - fy0;
+    auto wrap = [&](int64_t i) { return int((i % env.width + env.width) % env.width); };
+    int x0 = wrap(int64_t(fx0)), x1 = wrap(int64_t(fx0) + 1);
+    int y0 = int(fy0), y1 = std::min(y0 + 1, env.height - 1);
+    return glm::mix(glm::mix(env.at(x0, y0), env.at(x1, y0), fx), glm::mix(env.at(x0, y1), env.at(x1, y1), fx), fy);
+}
+
+glm::vec3 ReferenceBaker::Impl::albedoAt(const Material& m, glm::vec2 uv0) const {
+    glm::vec3 a = m.albedo;
+    if (m.albedoTexture >= 0 && size_t(m.albedoTexture) < textures.size())
+        a *= sampleTexture(textures[size_t(m.albedoTexture)], uv0);
+    return glm::clamp(a, glm::vec3(0.0f), glm::vec3(1.0f));
+}
+
+glm::vec3 ReferenceBaker::Impl::emissionAt(const Material& m, glm::vec2 uv0) const {
+    glm::vec3 e = m.emission;
+    if (m.emissionTexture >= 0 && size_t(m.emissionTexture) < textures.size())
+        e *= sampleTexture(textures[size_t(m.emissionTexture)], uv0);
+    return e;
+}
+
+// Suns (exact) and one emitter sample (MIS-weighted against cosine sampling) at
+// x, as L_lm contributions times beta.
+glm::vec3 ReferenceBaker::Impl::directLight(const SurfacePoint& x, const glm::vec3& beta, float u1, float u2,
+                                            Counters& counters) const {
+    glm::vec3 sum(0.0f);
+    const glm::vec3 origin = x.p + x.ng * eps;
+    for (const DirectionalLight& light : lights) {
+        const glm::vec3 toSun = -light.direction;
+        float c = glm::dot(x.ns, toSun);
+        if (c <= 0.0f || glm::dot(x.ng, toSun) <= 0.0f) continue;
+        ++counters.shadowRays;
+        if (!occluded(origin, toSun, std::numeric_limits<float>::infinity()))
+            sum += light.irradiance * (c * INV_PI);
+    }
+    if (options.emitterSampling && !emitters.empty()) {
+        // pick by power with u1, then reuse u1 within the pick's interval: the 2D
+        // point stays stratified over all emitters together
+        size_t k = size_t(std::upper_bound(emitterCdf.begin(), emitterCdf.end(), u1) - emitterCdf.begin());
+        k = std::min(k, emitters.size() - 1);
+        const float lo = k > 0 ? emitterCdf[k - 1] : 0.0f, hi = emitterCdf[k];
+        u1 = hi > lo ? std::clamp((u1 - lo) / (hi - lo), 0.0f, 0x1.fffffep-1f) : 0.5f;
+        const uint32_t t = emitters[k];
+        const BakeVertex* v = &mesh.vertices[3 * size_t(t)];
+        float su = std::sqrt(u1);
+        float b0 = 1.0f - su, b1 = u2 * su, b2 = 1.0f - b0 - b1;
+        glm::vec3 y = b0 * glm::vec3(v[0].position) + b1 * glm::vec3(v[1].position) + b2 * glm::vec3(v[2].position);
+        glm::vec3 d = y - x.p;
+        float dist2 = glm::dot(d, d);
+        if (dist2 > eps * eps) {
+            float dist = std::sqrt(dist2);
+            glm::vec3 wi = d / dist;
+            float cx = glm::dot(x.ns, wi);
+            const BakeTriangle& tri = mesh.triangles[t];
+            float cl = -glm::dot(triNormal[t], wi);
+            if ((tri.flags & TRIANGLE_DOUBLE_SIDED) != 0u) cl = std::fabs(cl);
+            if (cx > 0.0f && glm::dot(x.ng, wi) > 0.0f && cl > 1e-7f) {
+                float pl = lightPdfArea[t] * dist2 / cl;
+                float pb = cx * INV_PI;
+                float w = pl * pl / (pl * pl + pb * pb);
+                const Material& m = materials[tri.material];
+                glm::vec2 uv0 = b0 * v[0].uv0 + b1 * v[1].uv0 + b2 * v[2].uv0;
+                glm::vec3 le = emissionAt(m, uv0);
+                if (maxComponent(le) > 0.0f) {
+                    ++counters.shadowRays;
+                    float tfar = glm::length(y - origin) - 2.0f * eps;
+                    if (tfar > 0.0f && !occluded(origin, wi, tfar)) sum += le * (pb / pl * w);
+                }
+            }
+        }
+    }
+    return beta * sum;
+}
+
+// One path from `start`: an estimate of L_lm there (light arriving, not leaving).
+glm::vec3 ReferenceBaker::Impl::sample(const SurfacePoint& start, uint32_t sampleIndex, uint64_t key,
+                                       const Scrambles& s, Counters& counters) const {
+    ++counters.paths;
+    Pcg32 rng(hash(key, sampleIndex));
+    glm::vec3 radiance(0.0f), beta(1.0f);
+    SurfacePoint x = start;
+    for (int depth = 0; depth < options.maxBounces; ++depth) {
+        // light sources seen directly from x
+        float ul1, ul2, ud1, ud2;
+        if (depth == 0) {
+            ul1 = unit(owenScramble(sobol0(sampleIndex), s.light0));
+            ul2 = unit(owenScramble(sobol1(sampleIndex), s.light1));
+            ud1 = unit(owenScramble(sobol0(sampleIndex), s.dir0));
+            ud2 = unit(owenScramble(sobol1(sampleIndex), s.dir1));
+        } else {
+            ul1 = rng.uniform();
+            ul2 = rng.uniform();
+            ud1 = rng.uniform();
+            ud2 = rng.uniform();
+        }
+        radiance += directLight(x, beta, ul1, ul2, counters);
+
+        // continue along a cosine-weighted direction
+        glm::vec3 t, b;
+        basis(x.ns, t, b);
+        const glm::vec3 local = cosineHemisphere(ud1, ud2);
+        glm::vec3 w = glm::normalize(t * local.x + b * local.y + x.ns * local.z);
+        const float cx = std::max(local.z, 0.0f);
+        if (glm::dot(w, x.ng) <= 0.0f) break;  // below its own triangle: blocked
+        RTCRayHit rh;
+        ++counters.rays;
+        const glm::vec3 origin = x.p + x.ng * eps;
+        if (!intersect(origin, w, rh)) {
+            radiance += beta * environment(w);
+            break;
+        }
+        const size_t tri = rh.hit.primID;
+        const BakeTriangle& bt = mesh.triangles[tri];
+        const glm::vec3 ng = triNormal[tri];
+        const bool front = glm::dot(w, ng) < 0.0f;
+        const bool doubleSided = (bt.flags & TRIANGLE_DOUBLE_SIDED) != 0u;
+        if (!front && !doubleSided) break;  // the back of a single-sided surface: opaque black
+        const BakeVertex* v = &mesh.vertices[3 * tri];
+        const float hu = rh.hit.u, hv = rh.hit.v, hw = 1.0f - hu - hv;
+        const glm::vec3 p = hw * glm::vec3(v[0].position) + hu * glm::vec3(v[1].position) + hv * glm::vec3(v[2].position);
+        const glm::vec2 uv0 = hw * v[0].uv0 + hu * v[1].uv0 + hv * v[2].uv0;
+        const Material& m = materials[bt.material];
+
+        // emission found by the cosine sample, MIS-weighted against the emitter sample
+        if ((bt.flags & TRIANGLE_EMISSIVE) != 0u) {
+            glm::vec3 le = emissionAt(m, uv0);
+            float weight = 1.0f;
+            if (options.emitterSampling && lightPdfArea[tri] > 0.0f) {
+                glm::vec3 d = p - x.p;
+                float cl = std::fabs(glm::dot(ng, w));
+                float pl = cl > 0.0f ? lightPdfArea[tri] * glm::dot(d, d) / cl : std::numeric_limits<float>::infinity();
+                float pb = cx * INV_PI;
+                weight = std::isfinite(pl) ? pb * pb / (pb * pb + pl * pl) : 0.0f;
+            }
+            radiance += beta * le * weight;
+        }
+
+        beta *= albedoAt(m, uv0);
+        if (maxComponent(beta) <= 0.0f) break;
+        if (depth + 1 >= options.rouletteDepth) {
+            float q = maxComponent(beta);
+            if (q < 1.0f) {
+                if (rng.uniform() >= q) break;
+                beta /= q;
+            }
+        }
+
+        // the next vertex: the side that was hit
+        glm::vec3 ns = hw * glm::vec3(v[0].normal) + hu * glm::vec3(v[1].normal) + hv * glm::vec3(v[2].normal);
+        float len = glm::length(ns);
+        ns = len > 0.0f && std::isfinite(len) ? ns / len : ng;
+        x.ng = front ? ng : -ng;
+        x.ns = front ? ns : -ns;
+        if (glm::dot(x.ns, x.ng) <= 0.0f) x.ns = x.ng;  // a shading normal bent past the face
+        x.p = p;
+    }
+    return radiance;
+}
+
+void ReferenceBaker::Impl::runPass(int first, int count) {
+    const size_t chunk = 16;
+    std::atomic<size_t> next{0};
+    std::vector<Counters> counters(size_t(options.threads));
+    auto work = [&](int thread) {
+#ifdef BB_HAVE_SSE_FTZ
+        _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+        _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+#endif
+        Counters& c = counters[size_t(thread)];
+        while (true) {
+            size_t begin = next.fetch_add(chunk);
+            if (begin >= texels.size()) break;
+            size_t end = std::min(begin + chunk, texels.size());
+            for (size_t i = begin; i < end; ++i) {
+                const Texel& texel = texels[i];
+                const uint64_t key = hash(options.seed, texel.page, texel.index);
+                const Scrambles s = makeScrambles(key);
+                glm::dvec3 sum = sums[i];
+                for (int k = 0; k < count; ++k) {
+                    glm::vec3 value = sample(texel.point, uint32_t(first + k), key, s, c);
+                    if (std::isfinite(value.x) && std::isfinite(value.y) && std::isfinite(value.z))
+                        sum += glm::dvec3(value);
+                }
+                sums[i] = sum;
+            }
+        }
+    };
+    std::vector<std::thread> pool;
+    for (int t = 1; t < options.threads; ++t) pool.emplace_back(work, t);
+    work(0);
+    for (auto& t : pool) t.join();
+    for (const Counters& c : counters) {
+        stats.paths += c.paths;
+        stats.rays += c.rays;
+        stats.shadowRays += c.shadowRays;
+    }
+}
+
+ReferenceBaker::ReferenceBaker(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+ReferenceBaker::~ReferenceBaker() = default;
+
+Expected<std::unique_ptr<ReferenceBaker>> ReferenceBaker::create(const Scene& scene, const Layout& layout,
+                                                                const ReferenceOptions& options) {
+    auto impl = std::make_unique<Impl>();
+    impl->options = options;
+    impl->layout = layout;
+    impl->mesh = buildBakeMesh(scene, layout);
+    Status s = impl->init(scene);
+    if (!s) return s;
+    return std::unique_ptr<ReferenceBaker>(new ReferenceBaker(std::move(impl)));
+}
+
+ReferenceProgress ReferenceBaker::step(double seconds) {
+    Impl& m = *impl_;
+    auto t0 = Clock::now();
+    while (m.stats.sppDone < m.options.spp) {
+        int count = std::min(m.options.passSpp, m.options.spp - m.stats.sppDone);
+        auto tp = Clock::now();
+        m.runPass(m.stats.sppDone, count);
+        m.stats.secondsTrace += secondsSince(tp);
+        m.stats.sppDone += count;
+        ++m.stats.passes;
+        if (secondsSince(t0) >= seconds) break;
+    }
+    return progress();
+}
+
+ReferenceProgress ReferenceBaker::progress() const { return {impl_->stats.sppDone, impl_->options.spp}; }
+
+LightmapPages ReferenceBaker::readLightmaps() const {
+    const Impl& m = *impl_;
+    const int res = m.layout.resolution;
+    const size_t perPage = size_t(res) * res;
+    LightmapPages out;
+    out.resolution = res;
+    std::vector<std::vector<glm::vec4>> maps(size_t(m.layout.pageCount), std::vector<glm::vec4>(perPage, glm::vec4(0.0f)));
+    const double scale = m.stats.sppDone > 0 ? 1.0 / m.stats.sppDone : 0.0;
+    for (size_t i = 0; i < m.texels.size(); ++i)
+        maps[m.texels[i].page][m.texels[i].index] = glm::vec4(glm::vec3(m.sums[i] * scale), 1.0f);
+    // dilation: an empty texel takes the mean of its filled 8-neighbours, padding + 1 times
+    const int passes = m.layout.padding + 1;
+    for (auto& map : maps) {
+        std::vector<uint8_t> cov(perPage);
+        for (size_t i = 0; i < perPage; ++i) cov[i] = map[i].w > 0.0f;
+        for (int pass = 0; pass < passes; ++pass) {
+            std::vector<glm::vec4> next = map;
+            for (int y = 0; y < res; ++y)
+                for (int x = 0; x < res; ++x) {
+                    if (map[size_t(y) * res + x].w > 0.0f) continue;
+                    glm::vec3 sum(0.0f);
+                    float count = 0.0f;
+                    for (int dy = -1; dy <= 1; ++dy)
+                        for (int dx = -1; dx <= 1; ++dx) {
+                            int qx = x + dx, qy = y + dy;
+                            if (qx < 0 || qy < 0 || qx >= res || qy >= res) continue;
+                            const glm::vec4& s = map[size_t(qy) * res + qx];
+                            if (s.w > 0.0f) {
+                                sum += glm::vec3(s);
+                                count += 1.0f;
+                            }
+                        }
+                    if (count > 0.0f) next[size_t(y) * res + x] = glm::vec4(sum / count, 1.0f);
+                }
+            map.swap(next);
+        }
+        io::ImageRgb img;
+        img.width = img.height = res;
+        img.pixels.resize(perPage);
+        for (size_t i = 0; i < perPage; ++i) img.pixels[i] = glm::vec3(map[i]);
+        out.pages.push_back(std::move(img));
+        out.covered.push_back(std::move(cov));
+    }
+    return out;
+}
+
+glm::vec3 ReferenceBaker::estimate(const glm::vec3& point, const glm::vec3& normal, int spp, uint64_t stream) const {
+    const Impl& m = *impl_;
+    SurfacePoint x;
+    x.p = point;
+    x.ns = x.ng = glm::normalize(normal);
+    const uint64_t key = hash(m.options.seed, 0xE57157A7Eull, stream);
+    const Scrambles s = makeScrambles(key);
+    Counters counters;
+    glm::dvec3 sum(0.0);
+    for (int i = 0; i < spp; ++i) sum += glm::dvec3(m.sample(x, uint32_t(i), key, s, counters));
+    return spp > 0 ? glm::vec3(sum / double(spp)) : glm::vec3(0.0f);
+}
+
+const ReferenceStats& ReferenceBaker::stats() const { return impl_->stats; }
+const BakeMesh& ReferenceBaker::mesh() const { return impl_->mesh; }
+
+}  // namespace bb

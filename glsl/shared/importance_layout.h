@@ -1,0 +1,36 @@
+// Bindings of the importance passes (engine/importance/importance_gl.cpp,
+// glsl/importance/*), shared by C++ and GLSL. Per-triangle buffers are tight
+// arrays of 4-byte values indexed like BakeMesh::triangles; the vertex buffer
+// is BakeVertex (engine/layout/bake_mesh.h, 48 bytes), read by the compute
+// pass as the std430 struct ImportanceVertex below.
+#ifndef BUNDLEBAKE_IMPORTANCE_LAYOUT_H
+#define BUNDLEBAKE_IMPORTANCE_LAYOUT_H
+
+#ifndef __cplusplus
+// BakeVertex as std430 sees it: 48 bytes, offsets 0, 16, 32, 40.
+struct ImportanceVertex {
+    vec4 position;    // xyz world position, w = 1
+    vec4 normal;      // unused here
+    vec2 uv0;         // unused here
+    vec2 lightmapUv;  // page-space light map coordinates
+};
+#endif
+
+// SSBOs (1 is lib/bake_vertex.glsl's Triangles, declared by the shared vertex shader)
+#define IMPORTANCE_BINDING_VERTICES 0     // ImportanceVertex vertices[] (3 per triangle; compute pass)
+#define IMPORTANCE_BINDING_MAX_DENSITY 2  // uint maxDensityBits[]: floatBitsToUint(I_max(t)), 0 = none
+#define IMPORTANCE_BINDING_IMPORTANCE 3   // float importance[]: I(t), Eq. (4)
+#define IMPORTANCE_BINDING_AREA_RATIO 4   // float areaRatio[]: A_l/A_o, Eq. (1)
+// Image units
+#define IMPORTANCE_IMAGE_DENSITY 0        // r32f: I(x) of Eq. (3) per texel (optional, for checks)
+#define IMPORTANCE_IMAGE_POSITIONS 1      // rgba32f: the page's position buffer, xyz world, a = 1 where mapped
+#define IMPORTANCE_IMAGE_TRIANGLES 2      // r32ui: its triangle index + 1, 0 = not mapped
+// Attachments of the position pass
+#define IMPORTANCE_OUT_POSITION 0
+#define IMPORTANCE_OUT_TRIANGLE 1
+// Compute work group size of the Eq. (4) pass
+#define IMPORTANCE_GROUP_SIZE 64
+// Eq. (1) when A_o = 0 < A_l (FLT_MAX; engine/importance/importance.h MAX_AREA_RATIO)
+#define IMPORTANCE_MAX_AREA_RATIO 3.402823466e38
+
+#endif

@@ -1,0 +1,162 @@
+// The `bundlebake bake` contract (DESIGN.md, CLI contract): bad input exits
+// non-zero with exactly one line on stderr, "bundlebake: error: ...", and
+// leaves nothing in OUTDIR; a successful bake leaves complete outputs
+// (lightmap_0.exr, manifest.json, stats.json with the figures DESIGN.md
+// lists) and no temp files. Runs the built CLI (BUNDLEBAKE_CLI).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+#include "io/image_io.h"
+#include "support/cli_helper.h"
+#include "support/gl_fixture.h"
+
+namespace bb::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string furnace() { return sourcePath("assets/furnace/furnace.gltf"); }
+
+void expectOneErrorLine(const CliResult& r, const std::string& mentions) {
+    EXPECT_NE(r.exitCode, 0) << "stderr: " << r.err;
+    EXPECT_NE(r.exitCode, -1) << "killed by a signal; stderr: " << r.err;
+    auto lines = r.errLines();
+    ASSERT_EQ(lines.size(), 1u) << "expected exactly one line on stderr, got:\n" << r.err;
+    EXPECT_EQ(lines[0].rfind("bundlebake: error:", 0), 0u) << lines[0];
+    EXPECT_NE(lines[0].find(mentions), std::string::npos) << "the error should mention '" << mentions << "': " << lines[0];
+    EXPECT_TRUE(r.out.empty()) << "stdout: " << r.out;
+}
+
+size_t filesIn(const fs::path& dir) {
+    std::error_code ec;
+    if (!fs::exists(dir, ec)) return 0;
+    size_t n = 0;
+    for (auto it = fs::recursive_directory_iterator(dir, ec); it != fs::recursive_directory_iterator(); ++it) ++n;
+    return n;
+}
+
+TEST(CliBakeErrors, MissingSceneFile) {
+    TempDir tmp("missing-scene");
+    ASSERT_TRUE(tmp.ok());
+    const std::string missing = tmp / "no_such_scene.gltf";
+    CliResult r = runCli({"bake", missing, "-o", tmp / "out", "--backend", "osmesa", "--directions", "4"}, tmp);
+    expectOneErrorLine(r, "no_such_scene.gltf");
+    EXPECT_EQ(filesIn(tmp.path() / "out"), 0u) << "nothing may be written for bad input";
+}
+
+TEST(CliBakeErrors, BadSkyValue) {
+    TempDir tmp("bad-sky");
+    ASSERT_TRUE(tmp.ok());
+    for (const char* sky : {"1,2", "red", "1,-1,0", "1,nan,1", "0.5,0.5,0.5,0.5"}) {
+        SCOPED_TRACE(std::string("--sky ") + sky);
+        CliResult r = runCli({"bake", furnace(), "-o", tmp / "out", "--backend", "osmesa", "--uv-layout", "asset",
+                              "--resolution", "16", "--directions", "4", "--sky", sky},
+                             tmp);
+        expectOneErrorLine(r, "--sky");
+        EXPECT_EQ(filesIn(tmp.path() / "out"), 0u) << "nothing may be written for bad input";
+    }
+}
+
+TEST(CliBakeErrors, UnwritableOutputDir) {
+    TempDir tmp("unwritable");
+    ASSERT_TRUE(tmp.ok());
+    // a path below a regular file cannot be created, not even by root
+    const std::string file = tmp / "a_file";
+    { std::ofstream(file) << "x"; }
+    for (const std::string& out : {file + "/out", file}) {
+        SCOPED_TRACE("-o " + out);
+        CliResult r = runCli({"bake", furnace(), "-o", out, "--backend", "osmesa", "--uv-layout", "asset",
+                              "--resolution", "16", "--directions", "4", "--no-progress"},
+                             tmp);
+        expectOneErrorLine(r, out);
+    }
+    EXPECT_EQ(readFileBytes(file), "x");
+}
+
+TEST(CliBake, SuccessWritesCompleteOutputsAndNoTempFiles) {
+    TempDir tmp("success");
+    ASSERT_TRUE(tmp.ok());
+    const std::string out = tmp / "out";
+    CliResult r = runCli({"bake", furnace(), "-o", out, "--backend", "osmesa", "--uv-layout", "asset", "--resolution",
+                          "16", "--directions", "16", "--seed", "3", "--no-progress"},
+                         tmp);
+    if (r.exitCode != 0 && r.err.find("osmesa") != std::string::npos && r.err.find("context") != std::string::npos)
+        GTEST_SKIP() << "no OSMesa context: " << r.err;
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    for (const auto& line : r.errLines()) EXPECT_EQ(line.find("error"), std::string::npos) << line;
+
+    for (const char* name : {"lightmap_0.exr", "manifest.json", "stats.json"})
+        EXPECT_TRUE(fs::is_regular_file(fs::path(out) / name)) << name << " missing";
+    for (const auto& entry : fs::recursive_directory_iterator(out)) {
+        const std::string name = entry.path().filename().string();
+        EXPECT_EQ(name.find(".tmp"), std::string::npos) << "temp file left behind: " << name;
+    }
+
+    auto exr = io::readImageRgb(out + "/lightmap_0.exr");
+    ASSERT_TRUE(exr) << exr.error();
+    EXPECT_EQ(exr->width, 16);
+    EXPECT_EQ(exr->height, 16);
+    float maxValue = 0;
+    for (const auto& p : exr->pixels) maxValue = std::max({maxValue, p.r, p.g, p.b});
+    EXPECT_GT(maxValue, 1.0f) << "a furnace bake (Le = 1) should light the page";
+
+    nlohmann::json manifest = nlohmann::json::parse(readFileBytes(out + "/manifest.json"), nullptr, false);
+    ASSERT_FALSE(manifest.is_discarded()) << "manifest.json is not JSON";
+    EXPECT_EQ(manifest.value("layout", ""), "asset");
+    EXPECT_EQ(manifest.value("resolution", 0), 16);
+    ASSERT_TRUE(manifest.contains("pages") && manifest["pages"].is_array());
+    ASSERT_EQ(manifest["pages"].size(), 1u);
+    EXPECT_EQ(manifest["pages"][0].value("exr", ""), "lightmap_0.exr");
+    ASSERT_TRUE(manifest.contains("instances") && manifest["instances"].is_array());
+    EXPECT_EQ(manifest["instances"].size(), 2u) << "furnace: outer and inner box";
+    EXPECT_TRUE(manifest.contains("units"));
+
+    nlohmann::json stats = nlohmann::json::parse(readFileBytes(out + "/stats.json"), nullptr, false);
+    ASSERT_FALSE(stats.is_discarded()) << "stats.json is not JSON";
+    auto number = [&](const std::string& pointer) -> double {
+        nlohmann::json::json_pointer p(pointer);
+        if (!stats.contains(p) || !stats[p].is_number()) {
+            ADD_FAILURE() << "stats.json lacks the number " << pointer;
+            return -1;
+        }
+        return stats[p].get<double>();
+    };
+    // DESIGN.md "Figures every bake reports"
+    // wall time per phase
+    for (const char* phase : {"setup", "bundle", "update", "resolve", "total"})
+        EXPECT_GE(number(std::string("/seconds/") + phase), 0.0) << phase;
+    EXPECT_GT(number("/seconds/total"), 0.0);
+    // directions
+    EXPECT_EQ(number("/directions/done"), 16);
+    EXPECT_EQ(number("/directions/total"), 16);
+    // tiles per direction
+    EXPECT_GE(number("/tiles/per_direction_mean"), 1.0);
+    EXPECT_GE(number("/tiles/per_direction_max"), 1.0);
+    EXPECT_GE(number("/tiles/drawn"), 16.0);
+    // predicted vs actual nodes per tile (ratio distribution)
+    for (const char* q : {"min", "p10", "median", "p90", "max"})
+        EXPECT_GT(number(std::string("/tiles/predicted_over_actual_nodes/") + q), 0.0) << q;
+    EXPECT_GE(number("/tiles/predicted_over_actual_nodes/count"), 16.0);
+    // overflows and re-draws
+    EXPECT_GE(number("/tiles/overflows_redrawn"), 0.0);
+    // peak node and head memory
+    EXPECT_GT(number("/memory/peak_nodes_per_tile"), 0.0);
+    EXPECT_GT(number("/memory/node_buffer_bytes"), 0.0);
+    EXPECT_GT(number("/memory/head_image_bytes"), 0.0);
+    EXPECT_GT(number("/memory/peak_gpu_bytes"), 0.0);
+    // light map texels
+    EXPECT_EQ(number("/lightmap/texels"), 16 * 16);
+    EXPECT_GT(number("/lightmap/covered_texels"), 0.0);
+    // fragments per second
+    EXPECT_GT(number("/throughput/fragments"), 0.0);
+    EXPECT_GT(number("/throughput/fragments_per_second_bundle_pass"), 0.0);
+    // bytes per texel and per node (DESIGN.md: 8 and 12)
+    EXPECT_EQ(number("/memory/bytes_per_lightmap_texel"), 8);
+    EXPECT_EQ(number("/memory/bytes_per_node"), 12);
+}
+
+}  // namespace
+}  // namespace bb::test
