@@ -22,13 +22,16 @@ uniform int page;
 void main() {
     if (gl_HelperInvocation) return;
     vec3 n = normalize(vNormal);
-    vec3 x = vPosition + n * normalOffset;
+    vec3 x = vPosition;
     vec3 toX = x - samplePoint;
     float facing = dot(emitterNormal, toX);
     if (!emitterDoubleSided && facing <= 0.0) return;  // behind a single-sided emitter
     if (dot(n, -toX) <= 0.0) return;                   // the sample is below x's horizon
-    float dist = length(toX);
-    float stored = texture(distances, toX).r;
+    // visibility from a point pushed off the surface (no self-shadowing); the
+    // form factor from the texel itself
+    vec3 shadowX = x + n * normalOffset - samplePoint;
+    float dist = length(shadowX);
+    float stored = texture(distances, shadowX).r;
     if (dist > stored + distanceBias + 0.002 * dist) return;  // occluded
     float f = polygonFormFactor(x, n, emitterA, emitterB, emitterC);
     ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), page);
