@@ -603,7 +603,10 @@ void Baker::Impl::bakeEmitters() {
     const glm::mat4 projection = glm::perspective(glm::radians(90.0f), 1.0f, nearPlane, farPlane);
     const float farValue = 1e30f;
     const float normalOffset = 0.5f * pixelSize;
-    const float distanceBias = 2.0f * pixelSize;
+    // Bias: a quarter bundle pixel, plus (in the shader) half a cube texel's
+    // footprint at the receiver's distance, the error of a nearest lookup.
+    // Kept well under a texel so walls one texel thick still cast shadows.
+    const float distanceBias = 0.25f * pixelSize;
 
     for (const Emitter& e : emitters) {
         const BakeVertex* v = &mesh.vertices[e.triangle * 3];
@@ -646,6 +649,7 @@ void Baker::Impl::bakeEmitters() {
             glUniform3fv(emitterProgram.uniform("samplePoint"), 1, &point.x);
             glUniform1f(emitterProgram.uniform("normalOffset"), normalOffset);
             glUniform1f(emitterProgram.uniform("distanceBias"), distanceBias);
+            glUniform1f(emitterProgram.uniform("footprintPerDistance"), 1.0f / float(size));
             glBindTextureUnit(0, cube.id());
             glBindImageTexture(BINDING_SUN, emitterMap.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
             glBindFramebuffer(GL_FRAMEBUFFER, pageFbo.id());

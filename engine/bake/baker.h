@@ -51,7 +51,7 @@ struct BakeOptions {
     // are at most 1024 triangles and 25% of the surface area.
     enum class DirectLight { Auto, Explicit, Bundles } directLight = DirectLight::Auto;
     int emitterSamples = 128;         // visibility samples over all explicit emitters (>= 1 per triangle)
-    int emitterShadowSize = 256;      // cube face size of each sample's distance map
+    int emitterShadowSize = 512;      // cube face size of each sample's distance map
 };
 
 // Figures every bake reports (stats.json).

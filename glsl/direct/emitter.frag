@@ -17,6 +17,7 @@ uniform vec3 radianceOverSamples;         // Le / samples of this triangle
 uniform vec3 samplePoint;
 uniform float normalOffset;                // scene units: pushes x off its own surface
 uniform float distanceBias;                // scene units
+uniform float footprintPerDistance;        // half a cube texel's width per unit distance (1 / face size)
 uniform int page;
 
 void main() {
@@ -32,7 +33,7 @@ void main() {
     vec3 shadowX = x + n * normalOffset - samplePoint;
     float dist = length(shadowX);
     float stored = texture(distances, shadowX).r;
-    if (dist > stored + distanceBias + 0.002 * dist) return;  // occluded
+    if (dist > stored + distanceBias + footprintPerDistance * dist) return;  // occluded
     float f = polygonFormFactor(x, n, emitterA, emitterB, emitterC);
     ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), page);
     vec4 s = imageLoad(directMap, texel);

@@ -65,15 +65,22 @@ void main() {
     bool ahead = c > 0.0;  // the texel looks along +d
     uint ownSide = ahead ? NODE_VISIBLE_FROM_AHEAD : NODE_VISIBLE_FROM_BEHIND;
     uint seenSide = ahead ? NODE_VISIBLE_FROM_BEHIND : NODE_VISIBLE_FROM_AHEAD;
-    // The ray through the pixel centre passes up to half a pixel diagonal
-    // beside the texel; the texel's own surface crosses it within
-    // offset * tan(theta) in depth. Find that crossing (a fragment facing the
-    // texel's side): the ray then starts exactly on the surface. If there is
-    // none, the ray runs beside the surface (past a wall's edge, outside a
-    // closed mesh) and would see what the texel cannot: the sample is
-    // invalid and skipped (W unchanged), as Unity's backface validity does.
-    float tanTheta = min(sqrt(max(1.0 - c * c, 0.0)) / max(abs(c), 1e-4), 8.0);
-    float eps = pixelSize * (0.7072 * tanTheta + 0.05) + depthBias;
+    // The ray through the pixel centre passes r (up to half a pixel diagonal)
+    // beside the texel; the texel's own surface crosses it within r * tan(theta)
+    // in depth. Find that crossing (a fragment facing the texel's side): the
+    // ray then starts exactly on the surface. The crossing must also lie within
+    // 2 pixels (one texel) of the texel in 3D: at grazing angles the ray
+    // meets the surface's plane far away, past a wall's edge, where a fragment
+    // of another surface facing the same way (the floor of the room behind a
+    // thin wall) would pass for it. No crossing: the ray runs beside the
+    // surface (past an edge, outside a closed mesh) and would see what the
+    // texel cannot, so the sample is skipped (W unchanged), as Unity's
+    // backface validity does.
+    vec2 offset = (b.xy - tileOrigin) - (vec2(pixel) + 0.5) * pixelSize;
+    float r2 = dot(offset, offset);
+    float reach = 2.0 * pixelSize;
+    float tanTheta = sqrt(max(1.0 - c * c, 0.0)) / max(abs(c), 1e-4);
+    float eps = min(sqrt(r2) * tanTheta + 0.05 * pixelSize, sqrt(max(reach * reach - r2, 0.0))) + depthBias;
     float self = 0.0;
     float selfDistance = 3.0e38;
     // `i < nodeCount` rather than `!= END_OF_LIST`: ends on any stray index too
