@@ -25,8 +25,13 @@ void main() {
     vec3 n = normalize(vNormal);
     vec3 x = vPosition;
     vec3 toX = x - samplePoint;
-    float facing = dot(emitterNormal, toX);
-    if (!emitterDoubleSided && facing <= 0.0) return;  // behind a single-sided emitter
+    // distance of x from the emitter's plane: behind a single-sided emitter
+    // nothing arrives, and a point in the plane (the emitter's own texels, a
+    // coplanar ceiling) gets nothing either: Lambert's formula would give it
+    // the whole hemisphere (F = 1) from inside the polygon
+    float facing = dot(emitterNormal, x - emitterA);
+    float planeEpsilon = 0.01 * normalOffset;
+    if (emitterDoubleSided ? abs(facing) <= planeEpsilon : facing <= planeEpsilon) return;
     if (dot(n, -toX) <= 0.0) return;                   // the sample is below x's horizon
     // visibility from a point pushed off the surface (no self-shadowing); the
     // form factor from the texel itself
