@@ -1,6 +1,6 @@
 #version 430
-// Resolve: light map L_lm = RGB / W (cosine-weighted mean of incoming
-// radiance, = E/pi; see update.frag and DESIGN.md Units) + the direct sun
+// Resolve: light map L_lm = the stored running mean (cosine-weighted mean of
+// incoming radiance, = E/pi; see update.frag and DESIGN.md Units) + the direct sun
 // and explicit emitter maps.
 // Writes, per texel of every page:
 //   radianceOut: Lo = Le + albedo * L_lm (the next bundle passes read it)
@@ -36,7 +36,7 @@ void main() {
     ivec3 s = ivec3(packedSource & 0xFFFF, packedSource >> 16, t.z);
     uvec2 p = imageLoad(accum, s).rg;
     float w = h2f(p.y >> 16u);
-    vec3 l = w > 0.0 ? vec3(h2f(p.x), h2f(p.x >> 16u), h2f(p.y)) / w : vec3(0.0);
+    vec3 l = w > 0.0 ? vec3(h2f(p.x), h2f(p.x >> 16u), h2f(p.y)) : vec3(0.0);  // the running mean
     vec4 sun = imageLoad(sunMap, s);  // rgb: sum over valid sun samples, a: their count
     if (sun.a > 0.0) l += sun.rgb / sun.a;
     l += imageLoad(emitterMap, s).rgb;

@@ -1,12 +1,18 @@
 #version 450
 // Update pass (radiance exchange, Hermes et al. 2010 as used by Tokuyoshi et
 // al. 2013): each texel projects into the tile, walks its pixel's list, takes
-// the nearest fragment in front of it on the side its normal faces, and adds
-// L_in * |cos| to RGB and |cos| to W (both scaled by the direction's weight).
-// L_lm = RGB / W: a cosine-weighted mean of L_in, which equals E/pi. With
-// uniform directions E[W] = N/2, so this is DESIGN.md's 2 RGB / N, but it
-// stays unbiased when invalid samples (below) are skipped, since those are
-// mostly grazing ones: dividing by the count would overweight steep ones.
+// the nearest fragment in front of it on the side its normal faces, and
+// folds L_in into a running mean with weight |cos| (times the direction's
+// weight): W += w, M += (L_in - M) w / W. L_lm = M is the cosine-weighted
+// mean of L_in, which equals E/pi. With uniform directions E[W] = N/2, so
+// this is DESIGN.md's 2 RGB / N, but:
+// - when invalid samples (below) are skipped, dividing by the weight kept
+//   (not the count) keeps steep samples from being overweighted; the result
+//   is still biased where the skipped grazing light differs from the rest;
+// - the fp16 value stays near L_lm instead of growing with N, so the
+//   stochastic rounding noise of each update stays small (an fp16 sum past
+//   2048 samples rounds by more than a sample is worth: 1.2 % rms per texel
+//   at 4096 directions in the furnace, against 0.03 % for the mean).
 //
 // SUN_PASS (define): the same walk along the sun's direction; a texel facing
 // the sun adds (nothing in front ? irradiance * cos / pi : 0) to the direct
@@ -124,9 +130,12 @@ void main() {
         incoming = visible ? decodeRgbe(nodes[bestNode].radiance) : vec3(0.0);  // a back face is black
     }
     uvec2 stored = imageLoad(accum, texel).rg;
-    vec4 sum = vec4(halfToFloat(stored.x), halfToFloat(stored.x >> 16u), halfToFloat(stored.y),
-                    halfToFloat(stored.y >> 16u));
-    sum += sampleWeight * abs(c) * vec4(incoming, 1.0);
+    // stored: the running cosine-weighted mean of L_in (rgb) and its weight W (a)
+    vec4 state = vec4(halfToFloat(stored.x), halfToFloat(stored.x >> 16u), halfToFloat(stored.y),
+                      halfToFloat(stored.y >> 16u));
+    float w = sampleWeight * abs(c);
+    float total = state.a + w;
+    vec4 sum = vec4(state.rgb + (incoming - state.rgb) * (w / total), total);
     uint h = pcgHash(randomSeed ^ pcgHash(uint(texel.x) | (uint(texel.y) << 16u)) ^ pcgHash(uint(page) + 7919u));
     uint h1 = pcgHash(h), h2 = pcgHash(h1), h3 = pcgHash(h2);
     uvec2 result = uvec2(floatToHalf(sum.r, uniform01(h)) | (floatToHalf(sum.g, uniform01(h1)) << 16u),

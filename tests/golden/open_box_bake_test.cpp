@@ -10,25 +10,34 @@
 // formula for a parallel rectangle, by superposition of four corner
 // rectangles; checked here against the probes' values to 1e-9). The texel
 // centre is up to half a floor texel (1.3 cm) from the probe point, which
-// moves V by up to 0.3% at (0.25, 0.1).
+// moves V by up to 0.5% at (0.25, 0.1). It also compares the mean L_lm over
+// every floor texel with the mean V at the same texel centres (exact,
+// whatever the grid), which averages the sampling noise away and so shows a
+// bias.
 //
-// Noise: sampling of the sky's visibility by stratified directions plus
-// fp16 rounding. Measured over seeds 1..10 (OSMesa), relative to V:
-//   64 directions: up to -16% / +15%; 256: -9% / +7%; 1024: -2.7% / +3.4%;
-//   2048 and 4096 are no better (-3.2% / +2.9%): the fp16 rounding noise grows
-//   with the direction count (rounding_bake_test.cpp).
-// At 1024 directions over seeds 1..30 (all channels): the centre texel's std is
-// 2.3% (range -3.5% .. +5.6%), the (0.25, 0.1) texel's 1.5% (-2.2% .. +3.5%).
-// Tolerances (4 std): 9% at the centre, 6% at (0.25, 0.1).
+// Noise: sampling of the sky's visibility by stratified directions plus fp16
+// rounding. One bake, over seeds (relative to V): 64 directions up to -16% /
+// +15%; 256: -9% / +7%; 1024: -3.5% / +5.6%; 2048 and 4096 are no better
+// (-3.2% / +2.9% over 8 seeds): the fp16 rounding noise grows with the
+// direction count (rounding_bake_test.cpp). So the test averages 4 bakes of
+// 1024 directions (seeds 1..4), which divides the noise by 2 without growing
+// the rounding noise. Standard deviations of one 1024-direction bake, over
+// seeds 1..30 (all channels): centre texel 2.3%, (0.25, 0.1) texel 1.5%,
+// floor mean 0.52%; halved for the 4-bake average: 1.15%, 0.75%, 0.26%.
+// Tolerances (4 std of the average): 5%, 3%, 1%.
 //
-// Floor mean: the mean L_lm over every floor texel against the mean V at the
-// same texel centres (exact, whatever the grid): over seeds 1..30 it was
-// -0.22% .. +1.69%, std 0.52%, tolerance 2% (4 std). Its average, +0.63%
-// (6 standard errors), is a bias of the baker: grazing directions (|cos| <
-// ~0.09, where the self-intersection search's tan(theta) is clamped at 8) are
-// skipped as "invalid" on the open floor, and from a floor those directions
-// see the black walls, so dropping them raises L_lm (interior floor texels
-// get W = 0.9975 x sum |cos|; a lone plane 1.0003).
+// Measured bias of the floor mean (30 single bakes): +0.63% (std 0.52%) with
+// update.frag as committed in 1122b3d; +2.48% (std 0.52%, every seed
+// +1.6% .. +3.6%) with the working tree of 16:35 whose self-crossing search
+// must stay within 2 pixels: grazing directions are skipped as "invalid",
+// and from a floor those directions see the black walls, so dropping them
+// raises L_lm (interior floor texels get W = 0.9975, then 0.979, x sum |cos|
+// over the directions; a lone plane 1.0003).
+//
+// That bias is the price of no light through walls one texel thick
+// (thin_wall_bake_test.cpp) and is documented in docs/design-notes.md, so the
+// floor-mean tolerance is the measured bias plus 4 std of the average:
+// 2.5% + 1% = 3.5%. A bias beyond that (or a new one) still fails.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -59,27 +68,40 @@ TEST(OpenBoxBake, FloorProbesMatchSkyViewFactor) {
     ASSERT_NEAR(openingViewFactor(0.25, 0.1), 0.220473362652, 1e-9);
 
     BB_REQUIRE_GL();
-    const int res = 64, directions = 1024;
-    const double floorTolerance = 0.02;
-    BakeOptions options;
-    options.directions = directions;
-    options.seed = 1;
-    options.sky = glm::vec3(1.0f);
-    SceneBake bake = makeBake("assets/open_box/open_box.gltf", assetLayout(res), options);
-    ASSERT_TRUE(bake) << bake.error;
-    const double seconds = bakeToEnd(*bake.baker);
-    LightmapPages maps = bake.baker->readLightmaps();
-    const BakeMesh& mesh = bake.baker->mesh();
-    std::vector<int> owner = texelTriangles(mesh, res);
+    const int res = 64, directions = 1024, bakes = 4;
+    const double floorTolerance = 0.035;  // known +2.5% skipping bias + 4 std (see the top)
+    // the average of `bakes` bakes with seeds 1..bakes
+    LightmapPages maps;
+    std::vector<int> owner;
+    std::unique_ptr<Baker> last;
+    double seconds = 0;
+    for (int seed = 1; seed <= bakes; ++seed) {
+        BakeOptions options;
+        options.directions = directions;
+        options.seed = uint64_t(seed);
+        options.sky = glm::vec3(1.0f);
+        SceneBake bake = makeBake("assets/open_box/open_box.gltf", assetLayout(res), options);
+        ASSERT_TRUE(bake) << bake.error;
+        seconds += bakeToEnd(*bake.baker);
+        LightmapPages one = bake.baker->readLightmaps();
+        if (seed == 1) {
+            maps = one;
+            for (auto& p : maps.pages[0].pixels) p = glm::vec3(0.0f);
+        }
+        for (size_t i = 0; i < one.pages[0].pixels.size(); ++i) maps.pages[0].pixels[i] += one.pages[0].pixels[i] / float(bakes);
+        last = std::move(bake.baker);
+    }
+    const BakeMesh& mesh = last->mesh();
+    owner = texelTriangles(mesh, res);
 
     struct Probe {
         const char* name;
         double u, v;        // uv1 from probes.json
         double x, z;        // floor point
         double expected;    // probes.json
-        double tolerance;   // relative, 4 x the measured std
-    } probes[] = {{"floor_centre", 0.315833, 0.315833, 0.0, 0.0, 0.239456470461, 0.09},
-                  {"floor_0.25_0.1", 0.465, 0.256167, 0.25, 0.1, 0.220473362652, 0.06}};
+        double tolerance;   // relative, 4 x the measured std of the average
+    } probes[] = {{"floor_centre", 0.315833, 0.315833, 0.0, 0.0, 0.239456470461, 0.05},
+                  {"floor_0.25_0.1", 0.465, 0.256167, 0.25, 0.1, 0.220473362652, 0.03}};
     // floor mean: every covered texel whose centre lies on the floor, against V at the same points
     double floorSum = 0, floorExpected = 0;
     size_t floorTexels = 0;
@@ -94,10 +116,14 @@ TEST(OpenBoxBake, FloorProbesMatchSkyViewFactor) {
     }
     ASSERT_GT(floorTexels, 1000u) << "the floor chart is about 38 x 38 texels";
     const double floorMean = floorSum / double(floorTexels), floorMeanExpected = floorExpected / double(floorTexels);
-    std::printf("[open box] floor: %zu texels, mean L_lm %.5f, mean V at their centres %.5f (%+.3f%%)\n", floorTexels,
-                floorMean, floorMeanExpected, 100 * (floorMean / floorMeanExpected - 1));
+    std::printf("[open box] %d bakes of %d directions, %.2f s; floor: %zu texels, mean L_lm %.5f, mean V at their "
+                "centres %.5f (%+.3f%%)\n",
+                bakes, directions, seconds, floorTexels, floorMean, floorMeanExpected,
+                100 * (floorMean / floorMeanExpected - 1));
     EXPECT_NEAR(floorMean, floorMeanExpected, floorTolerance * floorMeanExpected)
-        << "the floor's mean L_lm is not the mean sky view factor of its texels";
+        << "the floor's mean L_lm (average of " << bakes << " bakes) is " << 100 * (floorMean / floorMeanExpected - 1)
+        << "% off the mean sky view factor of its texels (noise std 0.26%): a bias, e.g. grazing samples skipped as "
+           "invalid (they see the black walls)";
 
     for (const Probe& p : probes) {
         int x = int(std::floor(p.u * res)), y = int(std::floor(p.v * res));
@@ -111,12 +137,12 @@ TEST(OpenBoxBake, FloorProbesMatchSkyViewFactor) {
         const double expected = openingViewFactor(w.x, w.z);
         const glm::vec3 got = maps.pages[0].pixels[i];
         std::printf("[open box] %s: texel (%d, %d) at (%.4f, %.4f, %.4f): L_lm (%.5f, %.5f, %.5f), V at texel centre "
-                    "%.5f, at probe %.5f (%d directions, %.2f s)\n",
-                    p.name, x, y, w.x, w.y, w.z, got.r, got.g, got.b, expected, p.expected, directions, seconds);
+                    "%.5f, at probe %.5f\n",
+                    p.name, x, y, w.x, w.y, w.z, got.r, got.g, got.b, expected, p.expected);
         for (int c = 0; c < 3; ++c)
             EXPECT_NEAR(got[c], expected, p.tolerance * expected)
                 << p.name << " channel " << c << ": L_lm is not the sky view factor within " << p.tolerance * 100
-                << "% after " << directions << " directions";
+                << "% (average of " << bakes << " bakes of " << directions << " directions)";
     }
 }
 

@@ -11,14 +11,14 @@
 // Expected value: with historyPower 0 the bake is far from converged at rho
 // 0.9 (the iteration's start-up bias), so the reference is the iteration's
 // exact expectation, furnaceExpectation(Le = 1, rho = 0.8999 (the fp16 albedo
-// the meta pass stores), 8192, power 0) = 6.1971 (the converged answer is 10).
+// the meta pass stores), 8192, power 0) = 6.1878 (the converged answer is 10).
 //
 // Measured over seeds 1..10 (OSMesa):
-//   stochastic: mean 6.1407..6.2159 (-0.91% .. +0.30% of 6.1971), max W 4180..4276
+//   stochastic: mean 6.1407..6.2159 (-0.76% .. +0.45% of 6.1878), max W 4180..4276
 //   nearest:    mean 9.0183..9.1981 (+45% .. +48%), max W exactly 2048 (stalled);
 //               RGB (~9 x W) keeps growing past 16384 as its increments of up to
 //               ~9 round up to the spacing 8 or 16 more often than down.
-// Tolerances: stochastic mean within 2% of the expectation (2x the worst seed);
+// Tolerances: stochastic mean within 2% of the expectation (2.6x the worst seed);
 // nearest mean more than 20% away from it (less than half the smallest drift).
 //
 // (In the rho 0.5 furnace nearest does not show it: W stalls at 2048 and RGB
@@ -95,8 +95,9 @@ TEST(RoundingBake, NearestDivergesPastW2048StochasticTracksExpectation) {
 // increment smaller than the fp16 spacing is a coin flip of one spacing, so
 // the sums' relative noise grows like sqrt(N) x 2^-11 (Connolly, Higham &
 // Mary 2021), not 1/sqrt(N). Measured worst texel over seeds 1..10 (asset 64
-// x 64, S = (0.3, 0.6, 1.2)): 0.64% at 64 directions, 1.25% at 256; furnace
-// rho 0.5 per-texel std 0.30% (256), 0.62% (1024), 1.22% (4096).
+// x 64, S = (0.3, 0.6, 1.2)): 0.67% at 64 directions, 1.25% at 256, 2.6% at
+// 1024 (seeds 1..5); furnace rho 0.5 per-texel std 0.30% (256 directions),
+// 0.62% (1024), 1.22% (4096).
 //
 // Expectation asserted: at 1024 directions every texel is still within the
 // 1% that 64 directions achieve (SkyPlaneBake.UniformSkyGivesSkyEverywhere).
@@ -124,7 +125,7 @@ TEST(RoundingBake, SkyPlaneNoiseDoesNotGrowWithDirections) {
     std::printf("[rounding] sky plane, 1024 directions, %.2f s: worst texel %.3f%% off at %s\n", seconds, worst * 100,
                 texelName(worstTexel, 64).c_str());
     EXPECT_LE(worst, 0.01) << "with 1024 directions a texel is " << worst * 100
-                           << "% off the uniform sky (64 directions: < 0.64%): the fp16 accumulators' stochastic "
+                           << "% off the uniform sky (64 directions: < 0.67%): the fp16 accumulators' stochastic "
                               "rounding noise grows with the number of directions";
 }
 
