@@ -59,10 +59,15 @@ vec3 environment(vec3 dir) {
 }
 
 void main() {
+    // the triangle's own plane, from screen derivatives (before any return:
+    // derivatives need the whole quad)
+    vec3 faceNormal = cross(dFdx(vPosition), dFdy(vPosition));
     // llvmpipe runs helper lanes through the walk with undefined loads, where they
     // spin; they have no side effects to make, so leave at once (GLSL 4.50).
     if (gl_HelperInvocation) return;
     vec3 n = normalize(vNormal);
+    vec3 ng = length(faceNormal) > 0.0 ? normalize(faceNormal) : n;
+    if (dot(ng, n) < 0.0) ng = -ng;
     vec3 b = bundleFromWorld(vPosition);
     ivec2 pixel = ivec2(floor((b.xy - tileOrigin) / pixelSize));
     if (any(lessThan(pixel, ivec2(0))) || any(greaterThanEqual(pixel, tileSize))) return;  // another tile's
@@ -85,20 +90,27 @@ void main() {
     vec2 offset = (b.xy - tileOrigin) - (vec2(pixel) + 0.5) * pixelSize;
     float r2 = dot(offset, offset);
     float reach = 2.0 * pixelSize;
-    float tanTheta = sqrt(max(1.0 - c * c, 0.0)) / max(abs(c), 1e-4);
-    float eps = min(sqrt(r2) * tanTheta + 0.05 * pixelSize, sqrt(max(reach * reach - r2, 0.0))) + depthBias;
+    // where the ray meets the texel's own (triangle) plane, in depth
+    float cg = dot(ng, bundleDir);
+    if (abs(cg) < 1e-4) return;
+    float planeDepth = b.z + dot(vec2(dot(ng, bundleU), dot(ng, bundleV)), offset) / cg;
+    if (abs(planeDepth - b.z) > sqrt(max(reach * reach - r2, 0.0))) return;  // beyond one texel
+    // the own-surface fragment: facing the texel's side, at that depth (a
+    // surface facing the same way a millimetre off, such as a light under a
+    // ceiling, must not pass for it)
+    float tolerance = 0.05 * pixelSize + depthBias + 1e-5 * abs(planeDepth);
     float self = 0.0;
     float selfDistance = 3.0e38;
     // `i < nodeCount` rather than `!= END_OF_LIST`: ends on any stray index too
     for (uint i = imageLoad(heads, pixel).r; i < nodeCount; i = nodes[i].next) {
         float z = uintBitsToFloat(nodes[i].depth);
-        float dz = abs(z - b.z);
-        if (dz <= eps && (nodes[i].depth & ownSide) != 0u && dz < selfDistance) {
+        float dz = abs(z - planeDepth);
+        if (dz <= tolerance && (nodes[i].depth & ownSide) != 0u && dz < selfDistance) {
             selfDistance = dz;
             self = z;
         }
     }
-    if (selfDistance > eps) return;
+    if (selfDistance > tolerance) return;
     float start = self + (ahead ? depthBias : -depthBias);
 
     float best = ahead ? 3.0e38 : -3.0e38;
