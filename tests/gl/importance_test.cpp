@@ -12,6 +12,7 @@
 //    from the exact barycentric one by a few ulp of |p| + |grad p| R
 //    (positionBound); Eq. (3) and I_max inherit that (densityBound).
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <sys/wait.h>
 
@@ -502,7 +503,9 @@ struct CliRun {
 
 CliRun runCli(const std::string& args) {
     const std::string dir = ::testing::TempDir();
-    const std::string out = dir + "/imp_cli_out.txt", err = dir + "/imp_cli_err.txt";
+    // per process: ctest -j runs the CLI tests side by side
+    const std::string tag = std::to_string(::getpid());
+    const std::string out = dir + "/imp_cli_out_" + tag + ".txt", err = dir + "/imp_cli_err_" + tag + ".txt";
     CliRun r;
     const std::string backend = test::defaultTestBackend() == Backend::Egl ? "egl" : "osmesa";
     const int s = std::system((std::string(BUNDLEBAKE_CLI) + " importance " + args + " --backend " + backend + " >" +

@@ -34,10 +34,11 @@ constexpr int MODE_TRIANGLE_FAN = 6;
 
 // --- helpers ---------------------------------------------------------------
 
-// A shared scene: assets/ first (where the lead will copy them), then ../shared/scenes.
+// A shared scene, as copied into assets/shared/ with its licence (the tests
+// must pass from the project's own clone).
 std::string sceneFile(const std::string& relative) {
     const fs::path root(BUNDLEBAKE_SOURCE_DIR);
-    for (const fs::path& dir : {root / "assets", root / "assets" / "scenes", root / ".." / "shared" / "scenes"}) {
+    for (const fs::path& dir : {root / "assets" / "shared"}) {
         fs::path p = dir / relative;
         if (fs::exists(p)) return p.string();
     }
@@ -208,7 +209,7 @@ void expectOneLineError(const Expected<Scene>& result, const std::string& path,
 
 TEST(SceneLoaderShared, CornellBox) {
     const std::string path = sceneFile("cornell_box/CornellBox.glb");
-    ASSERT_FALSE(path.empty()) << "CornellBox.glb not found in assets/ or ../shared/scenes";
+    ASSERT_FALSE(path.empty()) << "CornellBox.glb not found in assets/shared";
     Expected<Scene> loaded = loadScene(path);
     ASSERT_TRUE(loaded) << loaded.error();
     const Scene& s = *loaded;
@@ -248,7 +249,7 @@ TEST(SceneLoaderShared, CornellBox) {
 
 TEST(SceneLoaderShared, LivingRoomSkipsZeroAreaTriangles) {
     const std::string path = sceneFile("living_room/living_room.glb");
-    ASSERT_FALSE(path.empty()) << "living_room.glb not found in assets/ or ../shared/scenes";
+    ASSERT_FALSE(path.empty()) << "living_room.glb not found in assets/shared";
     Expected<Scene> loaded = loadScene(path);
     ASSERT_TRUE(loaded) << loaded.error();
     const Scene& s = *loaded;
@@ -280,7 +281,7 @@ TEST(SceneLoaderShared, LivingRoomSkipsZeroAreaTriangles) {
 
 TEST(SceneLoaderShared, MixedLightingSunAndTextures) {
     const std::string path = sceneFile("mixed_lighting/MixedLightingExample.gltf");
-    ASSERT_FALSE(path.empty()) << "MixedLightingExample.gltf not found in assets/ or ../shared/scenes";
+    ASSERT_FALSE(path.empty()) << "MixedLightingExample.gltf not found in assets/shared";
     Expected<Scene> loaded = loadScene(path);
     ASSERT_TRUE(loaded) << loaded.error();
     const Scene& s = *loaded;
@@ -337,7 +338,7 @@ TEST(SceneLoaderShared, MixedLightingSunAndTextures) {
 
 TEST(SceneLoaderShared, Zdm2UsesDefaultMaterial) {
     const std::string path = sceneFile("zdm2/zdm2.glb");
-    ASSERT_FALSE(path.empty()) << "zdm2.glb not found in assets/ or ../shared/scenes";
+    ASSERT_FALSE(path.empty()) << "zdm2.glb not found in assets/shared";
     LoadOptions options;
     options.defaultAlbedo = glm::vec3(0.5f);
     const int warningsBefore = warningCount();
