@@ -1,3 +1,4 @@
+#include "layout/bake_mesh_gl.h"
 #include "bake/baker.h"
 
 #include <algorithm>
@@ -171,16 +172,7 @@ void Baker::Impl::uploadMesh() {
                                       mesh.vertices.data(), 0);
     triangleBuffer = gl::Buffer::create("bake triangles", int64_t(mesh.triangles.size() * sizeof(BakeTriangle)),
                                         mesh.triangles.data(), 0);
-    vao = gl::VertexArray::create("bake vertex array");
-    glVertexArrayVertexBuffer(vao.id(), 0, vertexBuffer.id(), 0, sizeof(BakeVertex));
-    const GLuint sizes[] = {4, 4, 2, 2};
-    const GLuint offsets[] = {offsetof(BakeVertex, position), offsetof(BakeVertex, normal), offsetof(BakeVertex, uv0),
-                              offsetof(BakeVertex, lightmapUv)};
-    for (GLuint a = 0; a < 4; ++a) {
-        glEnableVertexArrayAttrib(vao.id(), a);
-        glVertexArrayAttribFormat(vao.id(), a, sizes[a], GL_FLOAT, GL_FALSE, offsets[a]);
-        glVertexArrayAttribBinding(vao.id(), a, 0);
-    }
+    vao = createBakeVertexArray("bake vertex array", vertexBuffer);
 }
 
 void Baker::Impl::dispatchPages(GLuint program) {

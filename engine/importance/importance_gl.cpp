@@ -3,6 +3,7 @@
 //
 // Based on: Tokuyoshi, Sekine, da Silva, Kanai, "Adaptive Ray-bundle Tracing
 // with Memory Usage Prediction", CGF 32(7) 2013, supplement §1.
+#include "layout/bake_mesh_gl.h"
 #include "importance/importance_gl.h"
 
 #include <algorithm>
@@ -85,16 +86,7 @@ Expected<ImportanceGlResult> ImportanceAnalyzer::analyze(const BakeMesh& mesh, i
     // upload: the bake vertices (vertex attributes for passes 1-2, an SSBO for pass 3)
     gl::Buffer vertices = gl::Buffer::create("importance vertices", int64_t(mesh.vertices.size() * sizeof(BakeVertex)),
                                              mesh.vertices.data(), 0);
-    gl::VertexArray vao = gl::VertexArray::create("importance vertex array");
-    glVertexArrayVertexBuffer(vao.id(), 0, vertices.id(), 0, sizeof(BakeVertex));
-    const GLuint sizes[] = {4, 4, 2, 2};
-    const GLuint offsets[] = {offsetof(BakeVertex, position), offsetof(BakeVertex, normal), offsetof(BakeVertex, uv0),
-                              offsetof(BakeVertex, lightmapUv)};
-    for (GLuint a = 0; a < 4; ++a) {
-        glEnableVertexArrayAttrib(vao.id(), a);
-        glVertexArrayAttribFormat(vao.id(), a, sizes[a], GL_FLOAT, GL_FALSE, offsets[a]);
-        glVertexArrayAttribBinding(vao.id(), a, 0);
-    }
+    gl::VertexArray vao = createBakeVertexArray("importance vertex array", vertices);
     const int64_t perTriangleBytes = int64_t(n) * 4;
     gl::Buffer maxDensity = gl::Buffer::create("importance I_max(t) bits", perTriangleBytes, nullptr, 0);
     const uint32_t zero = 0;

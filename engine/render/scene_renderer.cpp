@@ -1,5 +1,6 @@
 // The scene view: bake mesh + material textures + light map pages, drawn
 // through a camera with the bake's display transform. See scene_renderer.h.
+#include "layout/bake_mesh_gl.h"
 #include "render/scene_renderer.h"
 
 #include <algorithm>
@@ -280,17 +281,8 @@ Expected<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const Scene& scen
         m->runs.back().count += 3;
     }
     m->indexBuffer = gl::Buffer::create("render indices", int64_t(indices.size() * 4), indices.data(), 0);
-    m->vao = gl::VertexArray::create("render vertex array");
-    glVertexArrayVertexBuffer(m->vao.id(), 0, m->vertexBuffer.id(), 0, sizeof(BakeVertex));
+    m->vao = createBakeVertexArray("render vertex array", m->vertexBuffer);
     glVertexArrayElementBuffer(m->vao.id(), m->indexBuffer.id());
-    const GLuint sizes[] = {4, 4, 2, 2};
-    const GLuint offsets[] = {offsetof(BakeVertex, position), offsetof(BakeVertex, normal), offsetof(BakeVertex, uv0),
-                              offsetof(BakeVertex, lightmapUv)};
-    for (GLuint a = 0; a < 4; ++a) {
-        glEnableVertexArrayAttrib(m->vao.id(), a);
-        glVertexArrayAttribFormat(m->vao.id(), a, GLint(sizes[a]), GL_FLOAT, GL_FALSE, offsets[a]);
-        glVertexArrayAttribBinding(m->vao.id(), a, 0);
-    }
 
     // material textures: linear floats back to sRGB bytes (the glTF's own
     // encoding), decoded by GL: half the memory of the baker's RGBA16F copies
