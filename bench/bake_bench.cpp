@@ -14,6 +14,7 @@
 
 #include "bake/baker.h"
 #include "core/log.h"
+#include "gl/gl.h"
 #include "headless/platform.h"
 
 using namespace bb;
@@ -84,14 +85,15 @@ int main(int argc, char** argv) {
         o.sky = c.sky;
         std::vector<double> perDir, frag, texel, resolve, setup;
         for (int r = 0; r < runs + 1; ++r) {  // run 0 is the warm-up (shader compiles, page faults)
-            auto baker = makeBaker(*scene, *layout, o);
-            auto t0 = std::chrono::steady_clock::now();
+            auto tc = std::chrono::steady_clock::now();
+            auto baker = makeBaker(*scene, *layout, o);  // upload, meta pass, emitters, sun
+            glFinish();
+            double created = std::chrono::duration<double>(std::chrono::steady_clock::now() - tc).count();
             baker->step(1e9);
-            double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
             if (r == 0) continue;
             const BakeStats& st = baker->stats();
             perDir.push_back(1e3 * (st.secondsBundle + st.secondsUpdate + st.secondsResolve) / o.directions);
-            setup.push_back(s - (st.secondsBundle + st.secondsUpdate + st.secondsResolve));
+            setup.push_back(created);
             frag.push_back(st.fragments / st.secondsBundle / 1e6);
             texel.push_back(st.updatedTexels / st.secondsUpdate / 1e6);
             resolve.push_back(1e3 * st.secondsResolve / o.directions);
