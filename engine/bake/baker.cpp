@@ -305,6 +305,11 @@ Status Baker::Impl::init(const Scene& scene) {
         gridSize = std::max(1, int(std::ceil(2.0 * sphereRadius / pixelSize)));
         pixelSize = 2.0f * sphereRadius / float(gridSize);
     }
+    GLint viewportDims[2] = {0, 0};
+    glGetIntegerv(GL_MAX_VIEWPORT_DIMS, viewportDims);
+    if (gridSize > std::min(viewportDims[0], viewportDims[1]))
+        return Status::error("the bundle would be " + std::to_string(gridSize) + " pixels across, beyond GL_MAX_VIEWPORT_DIMS " +
+                             std::to_string(viewportDims[0]) + "; lower --bundle-res, --resolution or --texel-density");
     stats.bundleResolution = gridSize;
     stats.pixelSize = pixelSize;
 
@@ -414,8 +419,9 @@ void Baker::Impl::setFrameUniforms(GLuint program, const glm::vec3& d, const glm
     glUniform3fv(glGetUniformLocation(program, "bundleDir"), 1, &d.x);
     glUniform3fv(glGetUniformLocation(program, "bundleU"), 1, &u.x);
     glUniform3fv(glGetUniformLocation(program, "bundleV"), 1, &v.x);
-    glm::vec2 tileOrigin = origin + glm::vec2(tile.x, tile.y) * pixelSize;
-    glUniform2fv(glGetUniformLocation(program, "tileOrigin"), 1, &tileOrigin.x);
+    glUniform2fv(glGetUniformLocation(program, "gridOrigin"), 1, &origin.x);
+    glUniform1i(glGetUniformLocation(program, "gridSize"), gridSize);
+    glUniform2i(glGetUniformLocation(program, "tileOffset"), tile.x, tile.y);
     glUniform1f(glGetUniformLocation(program, "pixelSize"), pixelSize);
     glUniform2i(glGetUniformLocation(program, "tileSize"), tile.width, tile.height);
 }
@@ -436,7 +442,8 @@ void Baker::Impl::traceBundle(const glm::vec3& d, glm::vec2 jitter, uint32_t see
     // initial grid: tiles no larger than the head image, enough of them for the prediction to fit
     double predicted = predictNodes(d);
     int perSide = (gridSize + maxTileSize - 1) / maxTileSize;
-    while (predicted / (double(perSide) * perSide) > 0.8 * nodeCapacity && perSide < gridSize) perSide *= 2;
+    while (options.predictTiles && predicted / (double(perSide) * perSide) > 0.8 * nodeCapacity && perSide < gridSize)
+        perSide *= 2;
     std::vector<std::pair<TileRect, double>> work;
     int step = (gridSize + perSide - 1) / perSide;
     for (int y = 0; y < gridSize; y += step)
@@ -461,7 +468,10 @@ void Baker::Impl::traceBundle(const glm::vec3& d, glm::vec2 jitter, uint32_t see
             glUniform1ui(appendProgram.uniform("nodeCapacity"), uint32_t(std::min<int64_t>(nodeCapacity, 0xFFFFFFFEll)));
             glUniform1ui(appendProgram.uniform("randomSeed"), pcgHash(seed ^ pcgHash(uint32_t(tile.x * 7919 + tile.y))));
             glBindFramebuffer(GL_FRAMEBUFFER, bundleFbo.id());
-            glViewport(0, 0, tile.width, tile.height);
+            // the whole grid's viewport shifted so the tile lands at (0, 0); the scissor keeps the rest out
+            glViewport(-tile.x, -tile.y, gridSize, gridSize);
+            glEnable(GL_SCISSOR_TEST);
+            glScissor(0, 0, tile.width, tile.height);
             glBindVertexArray(vao.id());
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, triangleBuffer.id());
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_NODES, nodeBuffer.id());
@@ -469,6 +479,7 @@ void Baker::Impl::traceBundle(const glm::vec3& d, glm::vec2 jitter, uint32_t see
             glBindImageTexture(BINDING_HEADS, heads.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
             glBindTextureUnit(BINDING_RADIANCE, radiance.id());
             glDrawArrays(GL_TRIANGLES, 0, GLsizei(mesh.vertices.size()));
+            glDisable(GL_SCISSOR_TEST);
             glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                             GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
         }

@@ -43,6 +43,11 @@ struct BakeOptions {
     // directions (which saw light maps with few bounces) fade out. < 0 = from
     // the scene's largest albedo: round(2 rho / (1 - rho)), clamped to [1, 32].
     float historyPower = -1.0f;
+    // Cut each direction's bundle into enough tiles for the predicted node count
+    // (projected triangle areas / pixel area) to fit 80 % of the node buffer.
+    // false: only the head image's size limits tiles, and overflow detection
+    // alone splits them (tests).
+    bool predictTiles = true;
     int sunJitter = 2;                // sun bundles per axis (jittered sub-pixel), for antialiased shadows
     // Direct light from emissive triangles: Explicit = exact polygon form
     // factor times visibility from `emitterSamples` shadow cube maps (small

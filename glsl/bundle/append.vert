@@ -11,7 +11,10 @@ flat out vec3 vFaceNormal;
 
 void main() {
     vec3 b = bundleFromWorld(inPosition.xyz);
-    vec2 ndc = (b.xy - tileOrigin) / (pixelSize * vec2(tileSize)) * 2.0 - 1.0;
+    // clip space of the whole grid: the viewport (-tileOffset, gridSize) and a
+    // scissor to the tile select the tile, so every tile rasterizes the same
+    // window coordinates (an integer shift) and shares each edge's coverage
+    vec2 ndc = gridFromBundle(b.xy) / float(gridSize) * 2.0 - 1.0;
     gl_Position = vec4(ndc, 0.0, 1.0);  // no depth clipping: every fragment along the line counts
     vLightmapUv = inLightmapUv;
     vDepth = b.z;

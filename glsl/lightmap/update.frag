@@ -69,7 +69,8 @@ void main() {
     vec3 ng = length(faceNormal) > 0.0 ? normalize(faceNormal) : n;
     if (dot(ng, n) < 0.0) ng = -ng;
     vec3 b = bundleFromWorld(vPosition);
-    ivec2 pixel = ivec2(floor((b.xy - tileOrigin) / pixelSize));
+    vec2 g = gridFromBundle(b.xy);
+    ivec2 pixel = ivec2(floor(g)) - tileOffset;
     if (any(lessThan(pixel, ivec2(0))) || any(greaterThanEqual(pixel, tileSize))) return;  // another tile's
 
     float c = dot(n, bundleDir);
@@ -87,7 +88,7 @@ void main() {
     // surface (past an edge, outside a closed mesh) and would see what the
     // texel cannot, so the sample is skipped (W unchanged), as Unity's
     // backface validity does.
-    vec2 offset = (b.xy - tileOrigin) - (vec2(pixel) + 0.5) * pixelSize;
+    vec2 offset = (g - floor(g) - 0.5) * pixelSize;  // texel minus pixel centre, scene units
     float r2 = dot(offset, offset);
     float reach = 2.0 * pixelSize;
     // where the ray meets the texel's own (triangle) plane, in depth
