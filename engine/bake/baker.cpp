@@ -592,7 +592,15 @@ void Baker::Impl::bakeEmitters() {
     for (auto& e : emitters)
         e.samples = std::max(1, int(std::lround(options.emitterSamples * (totalPower > 0 ? e.power / totalPower : 0.0))));
 
-    const int size = std::max(16, options.emitterShadowSize);
+    // auto: 4 cube texels per bundle pixel across (gridSize pixels span the
+    // scene's diameter). Measured on the Cornell box at 64^2 texels: 64^2
+    // faces raise the error from 4.3 % to 5.0 %, 256^2 and 512^2 give 4.3 %
+    // and 256^2 costs 0.3 s instead of 0.5 s.
+    int size = options.emitterShadowSize;
+    if (size <= 0) {
+        size = 64;
+        while (size < 4 * gridSize && size < 512) size *= 2;
+    }
     gl::Texture cube = gl::Texture::createCube("emitter sample distances", GL_R32F, size);
     glTextureParameteri(cube.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTextureParameteri(cube.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);

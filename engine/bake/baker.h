@@ -56,7 +56,8 @@ struct BakeOptions {
     // are at most 1024 triangles and 25% of the surface area.
     enum class DirectLight { Auto, Explicit, Bundles } directLight = DirectLight::Auto;
     int emitterSamples = 128;         // visibility samples over all explicit emitters (>= 1 per triangle)
-    int emitterShadowSize = 512;      // cube face size of each sample's distance map
+    int emitterShadowSize = 0;        // cube face size of each sample's distance map; 0 = from the bundle
+                                      // resolution (4 cube texels per bundle pixel), 64..512
 };
 
 // Figures every bake reports (stats.json).
