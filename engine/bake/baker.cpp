@@ -662,7 +662,7 @@ void Baker::Impl::bakeEmitters() {
             glUniform1f(emitterProgram.uniform("distanceBias"), distanceBias);
             glUniform1f(emitterProgram.uniform("footprintPerDistance"), 1.0f / float(size));
             glBindTextureUnit(0, cube.id());
-            glBindImageTexture(BINDING_SUN, emitterMap.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
+            glBindImageTexture(BINDING_DIRECT, emitterMap.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
             glBindFramebuffer(GL_FRAMEBUFFER, pageFbo.id());
             glViewport(0, 0, layout.resolution, layout.resolution);
             for (int page = 0; page < layout.pageCount; ++page) {

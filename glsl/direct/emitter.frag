@@ -3,12 +3,13 @@
 // L_lm += Le * F(x -> triangle) * V(x, sample) / sampleCount, with F the exact
 // polygon form factor (no 1/r^2 noise near the emitter) and V read from the
 // sample's distance cube map. Accumulates into the direct map (rgb).
+#include "shared/bundle_layout.h"
 #include "lib/polygon_irradiance.glsl"
 
 in vec3 vPosition;
 in vec3 vNormal;
 
-layout(binding = 2, rgba32f) uniform coherent image2DArray directMap;
+layout(binding = BINDING_DIRECT, rgba32f) uniform coherent image2DArray directMap;
 layout(binding = 0) uniform samplerCube distances;
 uniform vec3 emitterA, emitterB, emitterC;  // world vertices
 uniform vec3 emitterNormal;

@@ -28,6 +28,7 @@ struct Node {
 #define BINDING_HEADS 0          // image unit: r32ui head pointers of the tile
 #define BINDING_ACCUM 1          // image unit: rg32ui accumulators (packed fp16 RGB + W), array of pages
 #define BINDING_SUN 2            // image unit: rgba32f direct sun L_lm, array of pages
+#define BINDING_DIRECT 2         // image unit: rgba32f explicit emitter L_lm (the emitter pass; same unit as the sun's)
 #define BINDING_RADIANCE 0       // texture unit: rgba16f outgoing radiance Lo per texel, array of pages
 #define BINDING_ENV 1            // texture unit: environment map (equirectangular)
 #define BINDING_MATERIAL_TEX 2   // texture unit: a material's albedo / emission texture
