@@ -83,11 +83,7 @@ int runBake(const BakeArgs& args) {
                         : args.direct == "bundles"  ? BakeOptions::DirectLight::Bundles
                                                     : BakeOptions::DirectLight::Auto;
     options.emitterSamples = args.emitterSamples;
-    if (!args.env.empty()) {
-        auto env = io::readImageRgb(args.env);
-        if (!env) return fail(env.error());
-        options.environment = std::move(env.value());
-    }
+    if (Status s = loadEnvironment(args.env, options.environment); !s) return fail(s.message());
     auto loaded = loadSceneAndLayout(args.scene);
     if (!loaded) return fail(loaded.error());
     if (Status s = io::ensureDirectory(args.outDir); !s) return fail(s.message());

@@ -73,6 +73,14 @@ Expected<int64_t> parseSize(const std::string& text, const char* flag) {
     return int64_t(v * mult);
 }
 
+Status loadEnvironment(const std::string& path, std::optional<io::ImageRgb>& environment) {
+    if (path.empty()) return Status::ok();
+    auto env = io::readImageRgb(path);
+    if (!env) return env.status();
+    environment = std::move(env.value());
+    return Status::ok();
+}
+
 Expected<LoadedScene> loadSceneAndLayout(const SceneArgs& a) {
     auto albedo = parseColor(a.defaultAlbedo, "--default-albedo");
     if (!albedo) return albedo.status();

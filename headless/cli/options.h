@@ -4,12 +4,14 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
 #include <glm/glm.hpp>
 
 #include "core/status.h"
+#include "io/image_io.h"
 #include "layout/layout.h"
 #include "scene/scene.h"
 
@@ -54,6 +56,8 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& args);
 Expected<glm::vec3> parseColor(const std::string& text, const char* flag);
 // Parses "512M", "2G", "300000K", "1048576" (bytes).
 Expected<int64_t> parseSize(const std::string& text, const char* flag);
+// Reads --env into `environment` when `path` is not empty; error names the file.
+Status loadEnvironment(const std::string& path, std::optional<io::ImageRgb>& environment);
 
 // Loads the scene and computes the layout from SceneArgs; errors are one line.
 struct LoadedScene {

@@ -45,11 +45,7 @@ int runReference(const ReferenceArgs& args) {
     options.emitterSampling = args.emitterSampling == "on";
     options.rouletteDepth = args.rouletteDepth;
     options.maxBounces = args.maxBounces;
-    if (!args.env.empty()) {
-        auto env = io::readImageRgb(args.env);
-        if (!env) return fail(env.error());
-        options.environment = std::move(env.value());
-    }
+    if (Status s = loadEnvironment(args.env, options.environment); !s) return fail(s.message());
     auto loaded = loadSceneAndLayout(args.scene);
     if (!loaded) return fail(loaded.error());
     if (Status s = io::ensureDirectory(args.outDir); !s) return fail(s.message());

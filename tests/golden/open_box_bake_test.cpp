@@ -18,10 +18,11 @@
 // Noise: sampling of the sky's visibility by stratified directions plus fp16
 // rounding. One bake, over seeds (relative to V): 64 directions up to -16% /
 // +15%; 256: -9% / +7%; 1024: -3.5% / +5.6%; 2048 and 4096 are no better
-// (-3.2% / +2.9% over 8 seeds): the fp16 rounding noise grows with the
-// direction count (rounding_bake_test.cpp). So the test averages 4 bakes of
-// 1024 directions (seeds 1..4), which divides the noise by 2 without growing
-// the rounding noise. Standard deviations of one 1024-direction bake, over
+// (-3.2% / +2.9% over 8 seeds): these were measured while the accumulators
+// held fp16 sums, whose rounding noise grew with the direction count
+// (rounding_bake_test.cpp); they now hold a running mean, which no longer
+// does. The test averages 4 bakes of 1024 directions (seeds 1..4), which
+// divides the noise by 2. Standard deviations of one 1024-direction bake, over
 // seeds 1..30 (all channels): centre texel 2.3%, (0.25, 0.1) texel 1.5%,
 // floor mean 0.52%; halved for the 4-bake average: 1.15%, 0.75%, 0.26%.
 // Tolerances (4 std of the average): 5%, 3%, 1%.

@@ -72,6 +72,32 @@ inline double bakeToEnd(Baker& baker) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// The uniform-sky plane (assets/sky_plane, 64 x 64 asset layout, sky S =
+// (0.3, 0.6, 1.2), seed 1) baked with `directions`: every covered texel's
+// L_lm should be S. Used by the sky-plane and rounding tests.
+struct SkyPlaneBake {
+    glm::vec3 sky{0.3f, 0.6f, 1.2f};
+    LightmapPages maps;
+    double seconds = 0;
+    std::string error;
+};
+
+inline SkyPlaneBake bakeSkyPlane(int directions) {
+    SkyPlaneBake out;
+    BakeOptions options;
+    options.directions = directions;
+    options.seed = 1;
+    options.sky = out.sky;
+    SceneBake bake = makeBake("assets/sky_plane/sky_plane.gltf", assetLayout(64), options);
+    if (!bake) {
+        out.error = bake.error;
+        return out;
+    }
+    out.seconds = bakeToEnd(*bake.baker);
+    out.maps = bake.baker->readLightmaps();
+    return out;
+}
+
 // Min / max / mean of one channel (or all three) over a set of texels.
 struct Summary {
     size_t count = 0;
