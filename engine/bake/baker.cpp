@@ -16,6 +16,8 @@
 #include "gl/objects.h"
 #include "gl/shader.h"
 #include "glsl/shared/bundle_layout.h"
+#include "importance/importance_gl.h"
+#include "tiler/tiler.h"
 
 namespace bb {
 namespace {
@@ -23,9 +25,16 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-// A rectangle of the bundle plane, in pixels of the direction's full grid.
-struct TileRect {
-    int x = 0, y = 0, width = 0, height = 0;
+// Where one tile lies: the direction's frame, its leaf and its window of
+// the leaf's grid (glsl/lib/bundle_frame.glsl reads these as uniforms).
+struct TileFrame {
+    glm::vec3 d{0.0f}, u{0.0f}, v{0.0f};
+    glm::vec2 rootOrigin{0.0f};
+    float rootSize = 1.0f;
+    BundleLeaf leaf;
+    TileWindow window;
+    float pixelSize = 1.0f;
+    uint32_t leafSeed = 0;  // per direction and leaf: the same for every budget
 };
 
 
@@ -75,13 +84,17 @@ struct Baker::Impl {
     glm::vec3 sphereCenter{0.0f};
     float sphereRadius = 1.0f;
     float pixelSize = 1.0f;
-    int gridSize = 1;         // pixels across the full bundle
-    int maxTileSize = 2048;   // head image side
+    int gridSize = 1;         // pixels across the uniform bundle (--tiling uniform, captures)
+    int maxTileSize = 2048;   // largest head image side the budget allows
     float depthBias = 0.0f;
     double historyPower = 0.0;
     double accumScale = 1.0;  // stored sums are true sums / accumScale
-    std::vector<double> projectedArea;  // per triangle world area (for prediction)
-    std::vector<glm::vec3> triangleNormal;
+    std::vector<double> projectedArea;  // per triangle world area
+    std::vector<Cluster> clusters;      // the mesh in culling units (engine/tiler)
+    TilerOptions tilerOptions;
+    std::vector<int32_t> drawFirst, drawCount;  // scratch: multi-draw ranges of a tile
+    BundleFrame lastFrame;                      // the latest direction's tiling (viewer overlay)
+    std::vector<BundleLeaf> lastLeaves;
 
     // GL objects
     gl::Buffer vertexBuffer, triangleBuffer, metaIndexBuffer, nodeBuffer, counterBuffer;
@@ -93,7 +106,9 @@ struct Baker::Impl {
     gl::Texture emitterMap;
     std::vector<glm::vec3> textureMeans;  // mean linear RGB of each scene texture (explicit emitters)
     std::vector<gl::Texture> materialTextures;
-    int64_t nodeCapacity = 0;
+    int64_t nodeCapacity = 0;     // nodes the budget allows in one tile
+    int64_t nodeAllocated = 0;    // nodes the buffer holds now (grown from the predictions)
+    int headSide = 0;             // the head image's side now (grown to the largest tile)
 
     Status init(const Scene& scene);
     Status buildPrograms();
@@ -103,15 +118,22 @@ struct Baker::Impl {
     bool useExplicitEmitters() const;
     void bakeEmitters();
     void bakeDirection(int index);
-    // Draws the bundle of direction d over the given tiles (splitting on
-    // overflow) and runs `update` for each tile that fits.
+    // Tiles the bundle of direction d (engine/tiler), draws each tile's
+    // culled clusters into the linked lists (growing the node buffer, or
+    // splitting the tile, on overflow) and, for each tile that fits, calls
+    // `update(frame, nodeCount)`, which binds its program and sets its
+    // uniforms; the tile's receiving clusters are then drawn in light map
+    // space with that program. oneTile: the uniform grid as one tile, no
+    // culling (captureBundle).
     template <class UpdateFn>
-    void traceBundle(const glm::vec3& d, glm::vec2 jitter, uint32_t seed, UpdateFn update, bool recordStats);
-    void setFrameUniforms(GLuint program, const glm::vec3& d, const glm::vec3& u, const glm::vec3& v,
-                          glm::vec2 origin, const TileRect& tile);
+    void traceBundle(const glm::vec3& d, glm::vec2 jitter, uint32_t seed, UpdateFn update, bool recordStats,
+                     bool oneTile = false);
+    void setFrameUniforms(GLuint program, const TileFrame& f);
+    void ensureNodes(int64_t nodes);
+    void ensureHeads(int side);
+    void drawClusters(const std::vector<uint32_t>& ids, bool receiversOnly);
     void resolveInto(bool radianceOut, gl::Texture& target);
     void dispatchPages(GLuint program);
-    double predictNodes(const glm::vec3& d) const;
 };
 
 nlohmann::json BakeStats::toJson() const {
@@ -125,10 +147,21 @@ nlohmann::json BakeStats::toJson() const {
     int maxTiles = tilesPerDirection.empty() ? 0 : *std::max_element(tilesPerDirection.begin(), tilesPerDirection.end());
     double meanTiles = tilesPerDirection.empty() ? 0.0
         : std::accumulate(tilesPerDirection.begin(), tilesPerDirection.end(), 0.0) / tilesPerDirection.size();
+    auto sizes = tilePixelSizes;
+    std::sort(sizes.begin(), sizes.end());
+    auto size = [&](double q) { return sizes.empty() ? 0.0 : double(sizes[size_t(q * (sizes.size() - 1))]); };
+    double meanLeaves = leavesPerDirection.empty() ? 0.0
+        : std::accumulate(leavesPerDirection.begin(), leavesPerDirection.end(), 0.0) / leavesPerDirection.size();
+    const double drawnTiles = double(std::max<int64_t>(tilesDrawn, 1)) * double(std::max<int64_t>(triangles, 1));
     j["tiles"] = {{"drawn", tilesDrawn}, {"per_direction_mean", meanTiles}, {"per_direction_max", maxTiles},
+                  {"leaves_per_direction_mean", meanLeaves},
                   {"overflows_redrawn", overflows},
                   {"predicted_over_actual_nodes", {{"min", pct(0)}, {"p10", pct(0.1)}, {"median", pct(0.5)},
-                                                   {"p90", pct(0.9)}, {"max", pct(1)}, {"count", sorted.size()}}}};
+                                                   {"p90", pct(0.9)}, {"max", pct(1)}, {"count", sorted.size()}}},
+                  {"pixel_size_scene_units", {{"min", size(0)}, {"median", size(0.5)}, {"max", size(1)}}}};
+    j["culling"] = {{"clusters", clusters}, {"triangles", triangles},
+                    {"bundle_pass_triangles_drawn_fraction", double(bundleTrianglesDrawn) / drawnTiles},
+                    {"update_pass_triangles_drawn_fraction", double(updateTrianglesDrawn) / drawnTiles}};
     j["memory"] = {{"node_capacity", nodeCapacity}, {"peak_nodes_per_tile", peakNodesPerTile},
                    {"node_buffer_bytes", nodeBufferBytes}, {"head_image_bytes", headImageBytes},
                    {"peak_gpu_bytes", peakGpuBytes}, {"bytes_per_node", 12}, {"bytes_per_lightmap_texel", 8}};
@@ -138,7 +171,7 @@ nlohmann::json BakeStats::toJson() const {
     double updateSeconds = secondsUpdate > 0 ? secondsUpdate : 1e-9;
     j["throughput"] = {{"fragments", fragments}, {"fragments_per_second_bundle_pass", fragments / bundleSeconds},
                        {"texel_samples", updatedTexels}, {"texel_samples_per_second_update_pass", updatedTexels / updateSeconds}};
-    j["seconds"] = {{"setup", secondsSetup}, {"sun", secondsSun}, {"emitters", secondsEmitters}, {"bundle", secondsBundle}, {"update", secondsUpdate},
+    j["seconds"] = {{"setup", secondsSetup}, {"importance", secondsImportance}, {"tiling", secondsTiling}, {"sun", secondsSun}, {"emitters", secondsEmitters}, {"bundle", secondsBundle}, {"update", secondsUpdate},
                     {"resolve", secondsResolve}, {"total", secondsTotal()}};
     return j;
 }
@@ -279,9 +312,13 @@ Status Baker::Impl::init(const Scene& scene) {
     sphereRadius = std::max(0.5f * glm::length(mesh.bounds.size()), 1e-6f) * 1.001f;
     depthBias = 4e-6f * (glm::length(sphereCenter) + sphereRadius);
 
+    // culling units: the triangles reordered into spatially coherent clusters
+    clusters = clusterMesh(mesh);
+    stats.triangles = int64_t(mesh.triangles.size());
+    stats.clusters = int64_t(clusters.size());
+
     // bundle pixel from the light map's texel density: sqrt(texel area / world area)
     double worldArea = 0, texelArea = 0;
-    triangleNormal.resize(mesh.triangles.size());
     projectedArea.resize(mesh.triangles.size());
     const double r = layout.resolution;
     for (size_t t = 0; t < mesh.triangles.size(); ++t) {
@@ -291,7 +328,6 @@ Status Baker::Impl::init(const Scene& scene) {
         glm::vec3 n = glm::cross(glm::vec3(b.position - a.position), glm::vec3(c.position - a.position));
         double area = 0.5 * glm::length(n);
         projectedArea[t] = area;
-        triangleNormal[t] = glm::length(n) > 0 ? glm::normalize(n) : glm::vec3(0);
         worldArea += area;
         glm::vec2 e1 = (b.lightmapUv - a.lightmapUv) * float(r), e2 = (c.lightmapUv - a.lightmapUv) * float(r);
         texelArea += 0.5 * std::abs(double(e1.x) * e2.y - double(e1.y) * e2.x);
@@ -305,26 +341,44 @@ Status Baker::Impl::init(const Scene& scene) {
         gridSize = std::max(1, int(std::ceil(2.0 * sphereRadius / pixelSize)));
         pixelSize = 2.0f * sphereRadius / float(gridSize);
     }
-    GLint viewportDims[2] = {0, 0};
-    glGetIntegerv(GL_MAX_VIEWPORT_DIMS, viewportDims);
-    if (gridSize > std::min(viewportDims[0], viewportDims[1]))
+    GLint vp[2] = {0, 0};
+    glGetIntegerv(GL_MAX_VIEWPORT_DIMS, vp);
+    const int maxViewport = std::min(vp[0], vp[1]);
+    if (options.tiling == BakeOptions::Tiling::Uniform && gridSize > maxViewport)
         return Status::error("the bundle would be " + std::to_string(gridSize) + " pixels across, beyond GL_MAX_VIEWPORT_DIMS " +
-                             std::to_string(viewportDims[0]) + "; lower --bundle-res, --resolution or --texel-density");
+                             std::to_string(maxViewport) + "; use --tiling adaptive, or lower --bundle-res, --resolution or --texel-density");
     stats.bundleResolution = gridSize;
     stats.pixelSize = pixelSize;
 
-    // tile limits: head image side and node capacity from the budget and GL limits
-    GLint vp[2] = {0, 0};
-    glGetIntegerv(GL_MAX_VIEWPORT_DIMS, vp);
-    maxTileSize = std::min({maxTex, vp[0], vp[1], 2048});
+    // tile limits, all read from GL: a leaf's grid is one viewport; a tile's
+    // side is the head image's; the node buffer is one SSBO binding; the
+    // budget holds the head image and the node buffer of one tile
+    maxTileSize = std::min({maxTex, maxViewport, 2048});
     while (maxTileSize > 64 && int64_t(maxTileSize) * maxTileSize * 4 > options.memoryBudget / 4) maxTileSize /= 2;
     int64_t headBytes = int64_t(maxTileSize) * maxTileSize * 4;
     GLint64 maxSsbo = 0;
     glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxSsbo);
-    nodeCapacity = std::min<int64_t>((options.memoryBudget - headBytes) / 12, maxSsbo / 12);
+    nodeCapacity = std::min<int64_t>({(options.memoryBudget - headBytes) / 12, maxSsbo / 12, int64_t(0xFFFFFFFEll)});
     if (nodeCapacity < 1024)
         return Status::error("--memory-budget is too small: the node buffer would hold fewer than 1024 nodes");
     stats.nodeCapacity = nodeCapacity;
+    tilerOptions.uniform = options.tiling == BakeOptions::Tiling::Uniform;
+    tilerOptions.fixedPixelSize = tilerOptions.uniform || options.bundleResolution > 0 ? pixelSize : 0.0;
+    tilerOptions.maxLeafPixels = std::min(1024, maxViewport);
+    tilerOptions.maxTilePixels = maxTileSize;
+    tilerOptions.nodeCapacity = options.predictTiles ? double(nodeCapacity) : 1e300;
+    tilerOptions.cull = options.cull;
+
+    // importance (supplement §1) decides each leaf's pixel size
+    {
+        auto t = Clock::now();
+        auto analyzer = ImportanceAnalyzer::create();
+        if (!analyzer) return analyzer.status();
+        auto result = (*analyzer)->analyze(mesh, layout.resolution);
+        if (!result) return result.status();
+        setClusterImportance(clusters, result->importance.importance);
+        stats.secondsImportance = secondsSince(t);
+    }
 
     // history ramp power from the largest albedo
     if (options.historyPower >= 0) {
@@ -357,11 +411,10 @@ Status Baker::Impl::init(const Scene& scene) {
     glClearTexImage(sunMap.id(), 0, GL_RGBA, GL_FLOAT, zeroF);
     glClearTexImage(emitterMap.id(), 0, GL_RGBA, GL_FLOAT, zeroF);
     glClearTexImage(radiance.id(), 0, GL_RGBA, GL_FLOAT, zeroF);
-    heads = gl::Texture::create2D("bundle head pointers", GL_R32UI, maxTileSize, maxTileSize);
-    nodeBuffer = gl::Buffer::create("bundle nodes", nodeCapacity * 12, nullptr, 0);
+    // node buffer and head image start small and grow to what the tiles predict
     counterBuffer = gl::Buffer::create("bundle node counter", 4, nullptr, GL_DYNAMIC_STORAGE_BIT);
-    stats.nodeBufferBytes = nodeBuffer.bytes();
-    stats.headImageBytes = heads.bytes();
+    ensureNodes(options.predictTiles ? std::min<int64_t>(nodeCapacity, 1 << 16) : nodeCapacity);
+    ensureHeads(64);
     bundleFbo = gl::Framebuffer::create("bundle framebuffer (no attachments)");
     glNamedFramebufferParameteri(bundleFbo.id(), GL_FRAMEBUFFER_DEFAULT_WIDTH, maxTileSize);
     glNamedFramebufferParameteri(bundleFbo.id(), GL_FRAMEBUFFER_DEFAULT_HEIGHT, maxTileSize);
@@ -414,71 +467,136 @@ Status Baker::Impl::init(const Scene& scene) {
     return Status::ok();
 }
 
-void Baker::Impl::setFrameUniforms(GLuint program, const glm::vec3& d, const glm::vec3& u, const glm::vec3& v,
-                                   glm::vec2 origin, const TileRect& tile) {
-    glUniform3fv(glGetUniformLocation(program, "bundleDir"), 1, &d.x);
-    glUniform3fv(glGetUniformLocation(program, "bundleU"), 1, &u.x);
-    glUniform3fv(glGetUniformLocation(program, "bundleV"), 1, &v.x);
-    glUniform2fv(glGetUniformLocation(program, "gridOrigin"), 1, &origin.x);
-    glUniform1i(glGetUniformLocation(program, "gridSize"), gridSize);
-    glUniform2i(glGetUniformLocation(program, "tileOffset"), tile.x, tile.y);
-    glUniform1f(glGetUniformLocation(program, "pixelSize"), pixelSize);
-    glUniform2i(glGetUniformLocation(program, "tileSize"), tile.width, tile.height);
+void Baker::Impl::setFrameUniforms(GLuint program, const TileFrame& f) {
+    glUniform3fv(glGetUniformLocation(program, "bundleDir"), 1, &f.d.x);
+    glUniform3fv(glGetUniformLocation(program, "bundleU"), 1, &f.u.x);
+    glUniform3fv(glGetUniformLocation(program, "bundleV"), 1, &f.v.x);
+    glUniform2fv(glGetUniformLocation(program, "rootOrigin"), 1, &f.rootOrigin.x);
+    glUniform1f(glGetUniformLocation(program, "rootSize"), f.rootSize);
+    glUniform2f(glGetUniformLocation(program, "leafMin"), float(f.leaf.min.x), float(f.leaf.min.y));
+    glUniform1f(glGetUniformLocation(program, "leafExtent"), float(f.leaf.extent));
+    glUniform1i(glGetUniformLocation(program, "leafPixels"), f.leaf.pixels);
+    glUniform1f(glGetUniformLocation(program, "pixelSize"), f.pixelSize);
+    glUniform2i(glGetUniformLocation(program, "tileOffset"), f.window.x, f.window.y);
+    glUniform2i(glGetUniformLocation(program, "tileSize"), f.window.width, f.window.height);
 }
 
-double Baker::Impl::predictNodes(const glm::vec3& d) const {
-    // expected fragments = sum of projected triangle areas / pixel area
-    double sum = 0;
-    for (size_t t = 0; t < projectedArea.size(); ++t) sum += projectedArea[t] * std::abs(glm::dot(triangleNormal[t], d));
-    return sum / (double(pixelSize) * pixelSize);
+void Baker::Impl::ensureNodes(int64_t nodes) {
+    nodes = std::min(nodes, nodeCapacity);
+    if (nodes <= nodeAllocated) return;
+    // grow by at least half, so a run of growing tiles reallocates a few times only
+    nodes = std::min(std::max(nodes, nodeAllocated + nodeAllocated / 2), nodeCapacity);
+    nodeBuffer = gl::Buffer();  // free first: the budget is for one buffer
+    nodeBuffer = gl::Buffer::create("bundle nodes", nodes * int64_t(sizeof(shared::Node)), nullptr, 0);
+    nodeAllocated = nodes;
+    stats.nodeBufferBytes = std::max<int64_t>(stats.nodeBufferBytes, nodeBuffer.bytes());
+}
+
+void Baker::Impl::ensureHeads(int side) {
+    if (side <= headSide) return;
+    int s = 64;
+    while (s < side) s *= 2;
+    s = std::min(s, maxTileSize);
+    heads = gl::Texture();
+    heads = gl::Texture::create2D("bundle head pointers", GL_R32UI, s, s);
+    headSide = s;
+    stats.headImageBytes = std::max<int64_t>(stats.headImageBytes, heads.bytes());
+}
+
+void Baker::Impl::drawClusters(const std::vector<uint32_t>& ids, bool receiversOnly) {
+    if (receiversOnly) {
+        std::vector<uint32_t> receivers;
+        for (uint32_t i : ids)
+            if (clusters[i].maxImportance > 0.0f) receivers.push_back(i);
+        clusterRanges(clusters, receivers, drawFirst, drawCount);
+    } else {
+        clusterRanges(clusters, ids, drawFirst, drawCount);
+    }
+    if (!drawFirst.empty()) glMultiDrawArrays(GL_TRIANGLES, drawFirst.data(), drawCount.data(), GLsizei(drawFirst.size()));
+    int64_t triangles = 0;
+    for (int32_t c : drawCount) triangles += c / 3;
+    (receiversOnly ? stats.updateTrianglesDrawn : stats.bundleTrianglesDrawn) += triangles;
 }
 
 template <class UpdateFn>
-void Baker::Impl::traceBundle(const glm::vec3& d, glm::vec2 jitter, uint32_t seed, UpdateFn update, bool recordStats) {
-    glm::vec3 u, v;
-    orthonormalBasis(d, u, v);
-    glm::vec2 origin = glm::vec2(glm::dot(sphereCenter, u), glm::dot(sphereCenter, v)) - glm::vec2(sphereRadius) +
-                       jitter * pixelSize;
-    // initial grid: tiles no larger than the head image, enough of them for the prediction to fit
-    double predicted = predictNodes(d);
-    int perSide = (gridSize + maxTileSize - 1) / maxTileSize;
-    while (options.predictTiles && predicted / (double(perSide) * perSide) > 0.8 * nodeCapacity && perSide < gridSize)
-        perSide *= 2;
-    std::vector<std::pair<TileRect, double>> work;
-    int step = (gridSize + perSide - 1) / perSide;
-    for (int y = 0; y < gridSize; y += step)
-        for (int x = 0; x < gridSize; x += step)
-            work.push_back({TileRect{x, y, std::min(step, gridSize - x), std::min(step, gridSize - y)},
-                            predicted * double(std::min(step, gridSize - x)) * std::min(step, gridSize - y) /
-                                (double(gridSize) * gridSize)});
+void Baker::Impl::traceBundle(const glm::vec3& d, glm::vec2 jitter, uint32_t seed, UpdateFn update, bool recordStats,
+                              bool oneTile) {
+    auto tt = Clock::now();
+    // the root square: the uniform grid, or (adaptive) the bounding sphere's square with a pixel of margin for the jitter
+    BundleFrame frame;
+    frame.dir = d;
+    orthonormalBasis(d, frame.u, frame.v);
+    TilerOptions to = tilerOptions;
+    const glm::dvec2 centre(glm::dot(glm::dvec3(sphereCenter), glm::dvec3(frame.u)),
+                            glm::dot(glm::dvec3(sphereCenter), glm::dvec3(frame.v)));
+    if (oneTile || to.uniform) {
+        to.uniform = true;
+        to.fixedPixelSize = pixelSize;
+        frame.size = double(gridSize) * pixelSize;
+        frame.origin = centre - glm::dvec2(sphereRadius) + glm::dvec2(jitter) * double(pixelSize);
+    } else {
+        frame.size = 2.0 * (double(sphereRadius) + pixelSize);
+        frame.origin = centre - glm::dvec2(sphereRadius + pixelSize) + glm::dvec2(jitter) * double(pixelSize);
+    }
+    if (oneTile) {
+        to.cull = false;
+        to.nodeCapacity = 1e300;
+        to.maxTilePixels = gridSize;
+    }
+    const std::vector<ClusterView> views = projectClusters(mesh, clusters, frame);
+    const DirectionTiling tiling = tileBundle(clusters, views, frame.size, to);
+    if (recordStats) {
+        stats.secondsTiling += secondsSince(tt);
+        stats.leavesPerDirection.push_back(int(tiling.leaves.size()));
+    }
+    if (recordStats) {
+        lastFrame = frame;
+        lastLeaves = tiling.leaves;
+    }
+
+    std::vector<Tile> work(tiling.tiles.rbegin(), tiling.tiles.rend());
     int tiles = 0;
     const uint32_t endOfList = END_OF_LIST;
     while (!work.empty()) {
-        auto [tile, tilePrediction] = work.back();
+        Tile tile = std::move(work.back());
         work.pop_back();
+        TileFrame f;
+        f.d = d;
+        f.u = frame.u;
+        f.v = frame.v;
+        f.rootOrigin = glm::vec2(frame.origin);
+        f.rootSize = float(frame.size);
+        f.leaf = tiling.leaves[size_t(tile.leaf)];
+        f.window = tile.window;
+        f.pixelSize = float(tiling.pixelSize(tile.leaf));
+        f.leafSeed = pcgHash(seed ^ pcgHash(uint32_t(tile.leaf) * 7919u + 17u));
+        // buffers sized from the prediction (a quarter of margin), within the budget
+        if (options.predictTiles) ensureNodes(int64_t(std::ceil(1.25 * tile.predictedNodes)) + 1024);
+        ensureHeads(std::max(tile.window.width, tile.window.height));
+
         auto tb = Clock::now();
         {
             gl::DebugGroup group("bundle pass");
-            glClearTexSubImage(heads.id(), 0, 0, 0, 0, tile.width, tile.height, 1, GL_RED_INTEGER, GL_UNSIGNED_INT,
-                               &endOfList);
+            glClearTexSubImage(heads.id(), 0, 0, 0, 0, tile.window.width, tile.window.height, 1, GL_RED_INTEGER,
+                               GL_UNSIGNED_INT, &endOfList);
             const uint32_t zero = 0;
             glNamedBufferSubData(counterBuffer.id(), 0, 4, &zero);
             glUseProgram(appendProgram.id());
-            setFrameUniforms(appendProgram.id(), d, u, v, origin, tile);
-            glUniform1ui(appendProgram.uniform("nodeCapacity"), uint32_t(std::min<int64_t>(nodeCapacity, 0xFFFFFFFEll)));
-            glUniform1ui(appendProgram.uniform("randomSeed"), pcgHash(seed ^ pcgHash(uint32_t(tile.x * 7919 + tile.y))));
+            setFrameUniforms(appendProgram.id(), f);
+            glUniform1ui(appendProgram.uniform("nodeCapacity"), uint32_t(nodeAllocated));
+            glUniform1ui(appendProgram.uniform("randomSeed"), f.leafSeed);
             glBindFramebuffer(GL_FRAMEBUFFER, bundleFbo.id());
-            // the whole grid's viewport shifted so the tile lands at (0, 0); the scissor keeps the rest out
-            glViewport(-tile.x, -tile.y, gridSize, gridSize);
+            // the leaf's grid with its viewport shifted so the tile lands at (0, 0); the scissor keeps the rest out
+            glViewport(-tile.window.x, -tile.window.y, f.leaf.pixels, f.leaf.pixels);
             glEnable(GL_SCISSOR_TEST);
-            glScissor(0, 0, tile.width, tile.height);
+            glScissor(0, 0, tile.window.width, tile.window.height);
             glBindVertexArray(vao.id());
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, triangleBuffer.id());
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_NODES, nodeBuffer.id());
             glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, BINDING_NODE_COUNTER, counterBuffer.id());
             glBindImageTexture(BINDING_HEADS, heads.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
             glBindTextureUnit(BINDING_RADIANCE, radiance.id());
-            glDrawArrays(GL_TRIANGLES, 0, GLsizei(mesh.vertices.size()));
+            drawClusters(tile.clusters, false);
             glDisable(GL_SCISSOR_TEST);
             glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                             GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
@@ -488,22 +606,26 @@ void Baker::Impl::traceBundle(const glm::vec3& d, glm::vec2 jitter, uint32_t see
         if (recordStats) stats.secondsBundle += secondsSince(tb);
         ++tiles;
         ++stats.tilesDrawn;
-        if (int64_t(count) > nodeCapacity) {
-            // overflow: nothing is used from this draw; split in four and redraw
+        if (int64_t(count) > nodeAllocated) {
+            // overflow: nothing is used from this draw. Redraw into a buffer of
+            // the measured size if the budget holds it, else in four quarters.
             ++stats.overflows;
-            CHECK(tile.width > 1 || tile.height > 1);
-            int hw = std::max(1, tile.width / 2), hh = std::max(1, tile.height / 2);
-            for (int k = 0; k < 4; ++k) {
-                TileRect t{tile.x + (k & 1) * hw, tile.y + (k >> 1) * hh, (k & 1) ? tile.width - hw : hw,
-                           (k >> 1) ? tile.height - hh : hh};
-                if (t.width > 0 && t.height > 0) work.push_back({t, tilePrediction / 4});
+            if (int64_t(count) <= nodeCapacity && options.predictTiles) {
+                ensureNodes(int64_t(count));
+                work.push_back(std::move(tile));
+                continue;
             }
+            CHECK(tile.window.width > 1 || tile.window.height > 1);
+            auto quarters = splitWindow(tile.window);
+            for (auto it = quarters.rbegin(); it != quarters.rend(); ++it)
+                work.push_back(makeTile(tiling, tile.leaf, *it, clusters, views, tile.clusters, to.cull));
             continue;
         }
         if (recordStats) {
             stats.fragments += count;
             stats.peakNodesPerTile = std::max<int64_t>(stats.peakNodesPerTile, count);
-            if (count > 0) stats.predictedOverActual.push_back(tilePrediction / count);
+            if (count > 0) stats.predictedOverActual.push_back(tile.predictedNodes / count);
+            stats.tilePixelSizes.push_back(f.pixelSize);
         }
         if (count == 0) continue;
         auto tu = Clock::now();
@@ -511,7 +633,13 @@ void Baker::Impl::traceBundle(const glm::vec3& d, glm::vec2 jitter, uint32_t see
             gl::DebugGroup group("update pass");
             glBindFramebuffer(GL_FRAMEBUFFER, pageFbo.id());
             glViewport(0, 0, layout.resolution, layout.resolution);
-            update(d, u, v, origin, tile, count);
+            GLuint program = update(f, count);
+            if (!program) continue;
+            setFrameUniforms(program, f);
+            glUniform1ui(glGetUniformLocation(program, "nodeCount"), count);
+            glBindImageTexture(BINDING_HEADS, heads.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_NODES, nodeBuffer.id());
+            drawClusters(tile.clusters, true);
             glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
         }
         if (recordStats) {
@@ -533,21 +661,12 @@ void Baker::Impl::bakeSun() {
             for (int jx = 0; jx < j; ++jx) {
                 glm::vec2 jitter((jx + 0.5f) / j - 0.5f, (jy + 0.5f) / j - 0.5f);
                 traceBundle(glm::normalize(light.direction), jitter, uint32_t(li * 1000 + jy * j + jx),
-                    [&](const glm::vec3& d, const glm::vec3& u, const glm::vec3& v, glm::vec2 origin, const TileRect& tile,
-                        uint32_t count) {
+                    [&](const TileFrame&, uint32_t) -> GLuint {
                         glUseProgram(sunProgram.id());
-                        glUniform1ui(sunProgram.uniform("nodeCount"), count);
-                        setFrameUniforms(sunProgram.id(), d, u, v, origin, tile);
                         glUniform3fv(sunProgram.uniform("sunIrradiance"), 1, &irradiance.x);
                         glUniform1f(sunProgram.uniform("depthBias"), depthBias);
-                        glBindImageTexture(BINDING_HEADS, heads.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
                         glBindImageTexture(BINDING_SUN, sunMap.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
-                        for (int page = 0; page < layout.pageCount; ++page) {
-                            glUniform1i(sunProgram.uniform("page"), page);
-                            GLint first = GLint(mesh.pageFirstTriangle[page] * 3);
-                            GLsizei n = GLsizei((mesh.pageFirstTriangle[page + 1] - mesh.pageFirstTriangle[page]) * 3);
-                            if (n) glDrawArrays(GL_TRIANGLES, first, n);
-                        }
+                        return sunProgram.id();
                     },
                     false);
             }
@@ -697,25 +816,17 @@ void Baker::Impl::bakeDirection(int k) {
     uint32_t seed = pcgHash(uint32_t(options.seed) * 0x9E3779B1u ^ pcgHash(uint32_t(k)));
     bool useEnv = bool(envTexture);
     traceBundle(d, glm::vec2(0.0f), seed,
-        [&](const glm::vec3& dd, const glm::vec3& u, const glm::vec3& v, glm::vec2 origin, const TileRect& tile,
-            uint32_t count) {
+        [&](const TileFrame&, uint32_t) -> GLuint {
             glUseProgram(updateProgram.id());
-            glUniform1ui(updateProgram.uniform("nodeCount"), count);
-            setFrameUniforms(updateProgram.id(), dd, u, v, origin, tile);
             glUniform1f(updateProgram.uniform("sampleWeight"), float(sampleWeight));
-            glUniform1ui(updateProgram.uniform("randomSeed"), pcgHash(seed ^ uint32_t(tile.x * 131 + tile.y * 8191)));
+            // per direction, not per tile: each texel is updated once per direction, and tiles change with the budget
+            glUniform1ui(updateProgram.uniform("randomSeed"), seed);
             glUniform3fv(updateProgram.uniform("sky"), 1, &options.sky.x);
             glUniform1i(updateProgram.uniform("useEnv"), useEnv);
             glUniform1f(updateProgram.uniform("depthBias"), depthBias);
             if (useEnv) glBindTextureUnit(BINDING_ENV, envTexture.id());
-            glBindImageTexture(BINDING_HEADS, heads.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
             glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
-            for (int page = 0; page < layout.pageCount; ++page) {
-                glUniform1i(updateProgram.uniform("page"), page);
-                GLint first = GLint(mesh.pageFirstTriangle[page] * 3);
-                GLsizei n = GLsizei((mesh.pageFirstTriangle[page + 1] - mesh.pageFirstTriangle[page]) * 3);
-                if (n) glDrawArrays(GL_TRIANGLES, first, n);
-            }
+            return updateProgram.id();
         },
         true);
     stats.updatedTexels += stats.coveredTexels;
@@ -820,20 +931,19 @@ Baker::BundleCapture Baker::captureBundle(const glm::vec3& dir) {
     BundleCapture cap;
     cap.dir = glm::normalize(dir);
     m.traceBundle(cap.dir, glm::vec2(0.0f), 12345u,
-        [&](const glm::vec3& d, const glm::vec3& u, const glm::vec3& v, glm::vec2 origin, const TileRect& tile,
-            uint32_t) {
-            cap.u = u;
-            cap.v = v;
-            cap.origin = origin;
-            cap.pixelSize = m.pixelSize;
-            cap.width = tile.width;
-            cap.height = tile.height;
-            (void)d;
+        [&](const TileFrame& f, uint32_t) -> GLuint {
+            cap.u = f.u;
+            cap.v = f.v;
+            cap.origin = f.rootOrigin;
+            cap.pixelSize = f.pixelSize;
+            cap.width = f.window.width;
+            cap.height = f.window.height;
+            return 0;  // no update
         },
-        false);
+        false, true);
     glGetNamedBufferSubData(m.counterBuffer.id(), 0, 4, &cap.nodeCount);
     if (cap.width == 0) return cap;  // nothing drawn
-    std::vector<uint32_t> heads(size_t(m.maxTileSize) * m.maxTileSize);
+    std::vector<uint32_t> heads(size_t(m.headSide) * m.headSide);
     glGetTextureImage(m.heads.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, GLsizei(heads.size() * 4), heads.data());
     std::vector<shared::Node> nodes(std::max<uint32_t>(cap.nodeCount, 1));
     glGetNamedBufferSubData(m.nodeBuffer.id(), 0, GLsizeiptr(nodes.size() * sizeof(shared::Node)), nodes.data());
@@ -844,7 +954,7 @@ Baker::BundleCapture Baker::captureBundle(const glm::vec3& dir) {
         for (int x = 0; x < cap.width; ++x) {
             std::vector<std::pair<float, uint32_t>> list;
             uint32_t steps = 0;
-            for (uint32_t i = heads[size_t(y) * m.maxTileSize + x]; i != END_OF_LIST; i = nodes[i].next) {
+            for (uint32_t i = heads[size_t(y) * m.headSide + x]; i != END_OF_LIST; i = nodes[i].next) {
                 if (i >= cap.nodeCount || ++steps > cap.nodeCount) {
                     cap.listsWellFormed = false;
                     break;
@@ -953,19 +1063,29 @@ uint32_t Baker::lightmapTextureId() const { return impl_->resolved.id(); }
 Baker::BundleGrid Baker::bundleGrid() const {
     const Impl& m = *impl_;
     BundleGrid g;
-    const int k = std::max(0, m.stats.directionsDone - 1);
-    if (m.directions.empty()) return g;
-    g.dir = m.directions[size_t(k)];
-    orthonormalBasis(g.dir, g.u, g.v);
-    g.origin = glm::vec2(glm::dot(m.sphereCenter, g.u), glm::dot(m.sphereCenter, g.v)) - glm::vec2(m.sphereRadius);
-    g.pixelSize = m.pixelSize;
-    g.gridSize = m.gridSize;
-    // the initial grid of traceBundle (keep in step with it)
-    const double predicted = m.predictNodes(g.dir);
-    int perSide = (m.gridSize + m.maxTileSize - 1) / m.maxTileSize;
-    while (predicted / (double(perSide) * perSide) > 0.8 * m.nodeCapacity && perSide < m.gridSize) perSide *= 2;
-    g.tileStep = (m.gridSize + perSide - 1) / perSide;
-    g.tiles = m.stats.directionsDone > 0 && !m.stats.tilesPerDirection.empty() ? m.stats.tilesPerDirection.back() : 0;
+    if (m.lastLeaves.empty()) {
+        // before any direction: the uniform grid of direction 0
+        if (m.directions.empty()) return g;
+        g.dir = m.directions[0];
+        orthonormalBasis(g.dir, g.u, g.v);
+        g.origin = glm::vec2(glm::dot(m.sphereCenter, g.u), glm::dot(m.sphereCenter, g.v)) - glm::vec2(m.sphereRadius);
+        g.pixelSize = m.pixelSize;
+        g.gridSize = m.gridSize;
+        g.tileStep = std::min(m.gridSize, m.maxTileSize);
+        return g;
+    }
+    // the latest direction: the finest leaf's pixels, and its side as the tile step
+    g.dir = m.lastFrame.dir;
+    g.u = m.lastFrame.u;
+    g.v = m.lastFrame.v;
+    g.origin = glm::vec2(m.lastFrame.origin);
+    const BundleLeaf* finest = &m.lastLeaves[0];
+    for (const BundleLeaf& l : m.lastLeaves)
+        if (l.extent / l.pixels < finest->extent / finest->pixels) finest = &l;
+    g.pixelSize = float(finest->extent * m.lastFrame.size / finest->pixels);
+    g.gridSize = int(std::ceil(m.lastFrame.size / g.pixelSize - 1e-6));
+    g.tileStep = std::max(1, finest->pixels);
+    g.tiles = m.stats.tilesPerDirection.empty() ? 0 : m.stats.tilesPerDirection.back();
     return g;
 }
 

@@ -32,8 +32,16 @@ namespace bb {
 
 struct BakeOptions {
     int directions = 256;             // bundle directions (each serves d and -d); typ. 64..4096
-    int bundleResolution = 0;         // pixels across the scene's bounding sphere; 0 = from the texel
-                                      // density (pixel = half a texel: no leaks through walls >= 1 texel)
+    int bundleResolution = 0;         // pixels across the scene's bounding sphere, every tile; 0 = from the
+                                      // importance (adaptive: each leaf's pixel is half its densest texel,
+                                      // which keeps light from leaking through walls >= 1 texel thick;
+                                      // uniform: half the scene's mean texel)
+    // Adaptive (the paper): a quadtree of leaves over the bundle plane, each
+    // with the pixel its importance asks for and its own projection
+    // (engine/tiler/tiler.h). Uniform (Hermes et al. 2010, the baseline): one
+    // grid over the whole scene at the mean texel density, cut into tiles.
+    enum class Tiling { Adaptive, Uniform } tiling = Tiling::Adaptive;
+    bool cull = true;                 // per tile, draw only the clusters whose bounds meet it (both passes)
     int64_t memoryBudget = 512ll << 20;  // bytes for the node buffer + head image of one tile
     uint64_t seed = 1;
     glm::vec3 sky{0.0f};              // uniform sky radiance (scene units)
@@ -43,10 +51,10 @@ struct BakeOptions {
     // directions (which saw light maps with few bounces) fade out. < 0 = from
     // the scene's largest albedo: round(2 rho / (1 - rho)), clamped to [1, 32].
     float historyPower = -1.0f;
-    // Cut each direction's bundle into enough tiles for the predicted node count
-    // (projected triangle areas / pixel area) to fit 80 % of the node buffer.
-    // false: only the head image's size limits tiles, and overflow detection
-    // alone splits them (tests).
+    // Cut each tile until its predicted node count (projected cluster areas /
+    // pixel area) fits 80 % of the budget's node buffer, and size the buffer
+    // from the predictions. false: the buffer is allocated at the budget and
+    // only overflow detection splits tiles (tests).
     bool predictTiles = true;
     int sunJitter = 2;                // sun bundles per axis (jittered sub-pixel), for antialiased shadows
     // Direct light from emissive triangles: Explicit = exact polygon form
@@ -64,8 +72,8 @@ struct BakeOptions {
 struct BakeStats {
     int directionsDone = 0;
     int directionsTotal = 0;
-    double bundleResolution = 0;      // pixels across the bounding sphere
-    double pixelSize = 0;             // scene units
+    double bundleResolution = 0;      // pixels across the bounding sphere (the uniform grid)
+    double pixelSize = 0;             // scene units (the uniform grid's; tiles: tilePixelSizes)
     double historyPower = 0;
     int64_t tilesDrawn = 0;
     int64_t overflows = 0;            // tiles whose node count exceeded capacity and were split and redrawn
@@ -80,12 +88,21 @@ struct BakeStats {
     int64_t coveredTexels = 0;
     std::vector<double> predictedOverActual;  // per tile: predicted nodes / actual nodes
     std::vector<int> tilesPerDirection;
+    std::vector<int> leavesPerDirection;
+    std::vector<float> tilePixelSizes;        // per tile drawn without overflow, scene units
+    int64_t triangles = 0;
+    int64_t clusters = 0;
+    int64_t bundleTrianglesDrawn = 0;         // over all bundle-pass draws (culling: << triangles x tiles)
+    int64_t updateTrianglesDrawn = 0;         // over all update-pass draws
     bool explicitEmitters = false;
     int emitterSampleCount = 0;
     double secondsEmitters = 0;
+    double secondsImportance = 0;     // part of setup
+    double secondsTiling = 0;         // cluster projection, quadtree and prediction (CPU), per direction
     double secondsSetup = 0, secondsSun = 0, secondsBundle = 0, secondsUpdate = 0, secondsResolve = 0;
     double secondsTotal() const {
-        return secondsSetup + secondsSun + secondsEmitters + secondsBundle + secondsUpdate + secondsResolve;
+        return secondsSetup + secondsSun + secondsEmitters + secondsTiling + secondsBundle + secondsUpdate +
+               secondsResolve;
     }
     nlohmann::json toJson() const;
 };
@@ -159,9 +176,9 @@ public:
     // rgb = L_lm (E/pi), a = 1 where a value exists (padding dilated). Owned by
     // the Baker; valid for its life; filled by resolveLightmaps()/readLightmaps().
     uint32_t lightmapTextureId() const;
-    // The bundle plane of the latest direction (direction 0 before any), for
-    // overlays: frame, pixel grid, and the initial tile grid (tileStep pixels
-    // square) as traceBundle lays it out before overflow splits.
+    // The bundle plane of the latest direction (direction 0's uniform grid
+    // before any), for overlays: frame, the finest leaf's pixel grid over the
+    // root square, and that leaf's side in pixels as the tile step.
     struct BundleGrid {
         glm::vec3 dir{0.0f, 0.0f, 1.0f}, u{1.0f, 0.0f, 0.0f}, v{0.0f, 1.0f, 0.0f};
         glm::vec2 origin{0.0f};  // (u, v) of pixel (0, 0)'s lower-left corner

@@ -12,6 +12,7 @@ in float vDepth;
 flat in uint vPage;
 flat in uint vFlags;
 flat in vec3 vFaceNormal;
+flat in uint vTriangle;
 
 layout(binding = BINDING_NODE_COUNTER) uniform atomic_uint nodeCounter;
 layout(binding = BINDING_HEADS, r32ui) uniform coherent uimage2D heads;
@@ -19,14 +20,15 @@ layout(std430, binding = BINDING_NODES) buffer Nodes { Node nodes[]; };
 layout(binding = BINDING_RADIANCE) uniform sampler2DArray radiance;
 
 uniform uint nodeCapacity;
-uniform uint randomSeed;  // per direction and tile
+uniform uint randomSeed;  // per direction and leaf (not per tile: tiles change with the budget, the bytes must not)
 
 void main() {
     uint index = atomicCounterIncrement(nodeCounter);
     if (index >= nodeCapacity) return;  // overflow: the host sees counter > capacity and redraws split
-    ivec2 pixel = ivec2(gl_FragCoord.xy);
+    ivec2 pixel = ivec2(gl_FragCoord.xy);  // in the tile (the head image)
+    ivec2 leafPixel = pixel + tileOffset;
     vec3 lo = textureLod(radiance, vec3(vLightmapUv, float(vPage)), 0.0).rgb;
-    uint h = pcgHash(randomSeed ^ pcgHash(uint(pixel.x) + 65536u * uint(pixel.y)) ^ pcgHash(uint(gl_PrimitiveID) + 0x9E3779B9u));
+    uint h = pcgHash(randomSeed ^ pcgHash(uint(leafPixel.x) + 65536u * uint(leafPixel.y)) ^ pcgHash(vTriangle + 0x9E3779B9u));
     vec3 u = vec3(uniform01(h), uniform01(pcgHash(h)), uniform01(pcgHash(h + 1u)));
     uint flags;
     if ((vFlags & TRIANGLE_DOUBLE_SIDED) != 0u)

@@ -8,13 +8,14 @@ out float vDepth;
 flat out uint vPage;
 flat out uint vFlags;
 flat out vec3 vFaceNormal;
+flat out uint vTriangle;
 
 void main() {
     vec3 b = bundleFromWorld(inPosition.xyz);
-    // clip space of the whole grid: the viewport (-tileOffset, gridSize) and a
-    // scissor to the tile select the tile, so every tile rasterizes the same
-    // window coordinates (an integer shift) and shares each edge's coverage
-    vec2 ndc = gridFromBundle(b.xy) / float(gridSize) * 2.0 - 1.0;
+    // clip space of the leaf's grid: the viewport (-tileOffset, leafPixels) and
+    // a scissor to the tile select the tile, so every tile of a leaf rasterizes
+    // the same window coordinates (an integer shift) and shares each edge's coverage
+    vec2 ndc = gridFromRoot(rootFromBundle(b.xy)) / float(leafPixels) * 2.0 - 1.0;
     gl_Position = vec4(ndc, 0.0, 1.0);  // no depth clipping: every fragment along the line counts
     vLightmapUv = inLightmapUv;
     vDepth = b.z;
@@ -22,4 +23,5 @@ void main() {
     vPage = tri.y;
     vFlags = tri.w;
     vFaceNormal = inNormal.xyz;
+    vTriangle = uint(gl_VertexID / 3);  // gl_PrimitiveID restarts with each draw of a multi-draw
 }

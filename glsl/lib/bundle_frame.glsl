@@ -1,17 +1,28 @@
 // The bundle's orthographic frame: direction d (rays travel along +d), plane
-// axes u, v (u x v = d), and one pixel grid over the whole bundle. A tile is
-// an integer window of that grid, so every tile computes a point's pixel with
-// the same float operations: no pixel is drawn or read by two tiles, or none.
+// axes u, v (u x v = d). The bundle plane's root square [rootOrigin,
+// rootOrigin + rootSize]^2 is cut into leaves (engine/tiler/tiler.h); a leaf
+// is one pixel grid of leafPixels^2 pixels over [leafMin, leafMin +
+// leafExtent]^2 in root units, and a tile is an integer window of that grid.
+// Every tile computes a point's root coordinates with the same float
+// operations and leaf bounds are exact in float (powers of 1/2), so a point
+// belongs to exactly one leaf and, within it, one tile: no ray is drawn or
+// read by two tiles, or by none.
 uniform vec3 bundleDir;
 uniform vec3 bundleU;
 uniform vec3 bundleV;
-uniform vec2 gridOrigin;     // (u, v) of the grid's pixel (0, 0) lower-left corner, scene units
-uniform float pixelSize;     // scene units per bundle pixel
-uniform int gridSize;        // pixels across the whole bundle
-uniform ivec2 tileOffset;    // the tile's first pixel in the grid
+uniform vec2 rootOrigin;     // (u, v) of the root square's lower-left corner, scene units
+uniform float rootSize;      // the root square's side, scene units
+uniform vec2 leafMin;        // the leaf's lower-left corner, root units
+uniform float leafExtent;    // the leaf's side, root units
+uniform int leafPixels;      // pixels across the leaf
+uniform float pixelSize;     // scene units per pixel of this leaf
+uniform ivec2 tileOffset;    // the tile's first pixel in the leaf's grid
 uniform ivec2 tileSize;      // pixels
 
 vec3 bundleFromWorld(vec3 p) { return vec3(dot(p, bundleU), dot(p, bundleV), dot(p, bundleDir)); }
 
-// Position in grid pixels (continuous).
-vec2 gridFromBundle(vec2 uv) { return (uv - gridOrigin) / pixelSize; }
+// Root units: [0, 1]^2 spans the root square.
+vec2 rootFromBundle(vec2 uv) { return (uv - rootOrigin) / rootSize; }
+bool leafOwns(vec2 q) { return all(greaterThanEqual(q, leafMin)) && all(lessThan(q, leafMin + vec2(leafExtent))); }
+// Position in the leaf's pixels (continuous).
+vec2 gridFromRoot(vec2 q) { return (q - leafMin) * (float(leafPixels) / leafExtent); }

@@ -24,6 +24,7 @@
 in vec3 vPosition;
 in vec3 vNormal;
 flat in uint vFlags;
+flat in uint vPage;
 
 layout(binding = BINDING_HEADS, r32ui) uniform readonly uimage2D heads;
 layout(std430, binding = BINDING_NODES) readonly buffer Nodes { Node nodes[]; };
@@ -38,7 +39,6 @@ uniform vec3 sky;
 uniform float sampleWeight;  // this direction's weight (history ramp), relative to the stored scale
 uniform uint randomSeed;
 #endif
-uniform int page;
 uniform uint nodeCount;      // nodes in this tile's lists (END_OF_LIST is larger)
 uniform float depthBias;      // scene units: float precision floor
 
@@ -69,8 +69,10 @@ void main() {
     vec3 ng = length(faceNormal) > 0.0 ? normalize(faceNormal) : n;
     if (dot(ng, n) < 0.0) ng = -ng;
     vec3 b = bundleFromWorld(vPosition);
-    vec2 g = gridFromBundle(b.xy);
-    ivec2 pixel = ivec2(floor(g)) - tileOffset;
+    vec2 q = rootFromBundle(b.xy);
+    if (!leafOwns(q)) return;  // another leaf's
+    vec2 g = gridFromRoot(q);
+    ivec2 pixel = min(ivec2(floor(g)), ivec2(leafPixels - 1)) - tileOffset;
     if (any(lessThan(pixel, ivec2(0))) || any(greaterThanEqual(pixel, tileSize))) return;  // another tile's
 
     float c = dot(n, bundleDir);
@@ -125,7 +127,7 @@ void main() {
             bestNode = i;
         }
     }
-    ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), page);
+    ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), int(vPage));
 
 #ifdef SUN_PASS
     // the sun pass's d is the light's travel direction: a texel facing the sun looks along -d
@@ -149,7 +151,7 @@ void main() {
     float w = sampleWeight * abs(c);
     float total = state.a + w;
     vec4 sum = vec4(state.rgb + (incoming - state.rgb) * (w / total), total);
-    uint h = pcgHash(randomSeed ^ pcgHash(uint(texel.x) | (uint(texel.y) << 16u)) ^ pcgHash(uint(page) + 7919u));
+    uint h = pcgHash(randomSeed ^ pcgHash(uint(texel.x) | (uint(texel.y) << 16u)) ^ pcgHash(vPage + 7919u));
     uint h1 = pcgHash(h), h2 = pcgHash(h1), h3 = pcgHash(h2);
     uvec2 result = uvec2(floatToHalf(sum.r, uniform01(h)) | (floatToHalf(sum.g, uniform01(h1)) << 16u),
                          floatToHalf(sum.b, uniform01(h2)) | (floatToHalf(sum.a, uniform01(h3)) << 16u));

@@ -6,10 +6,13 @@
 out vec3 vPosition;
 out vec3 vNormal;
 flat out uint vFlags;
+flat out uint vPage;
 
 void main() {
     gl_Position = vec4(inLightmapUv * 2.0 - 1.0, 0.0, 1.0);
     vPosition = inPosition.xyz;
     vNormal = inNormal.xyz;
-    vFlags = triangles[gl_VertexID / 3].w;
+    uvec4 tri = triangles[gl_VertexID / 3];
+    vFlags = tri.w;
+    vPage = tri.y;  // one draw covers every page
 }

@@ -1,0 +1,295 @@
+#include "tiler/tiler.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "core/check.h"
+
+namespace bb {
+namespace {
+
+// Cluster rectangles are padded by this much (root units) so that float
+// differences between the CPU projection here and the shaders' never cull a
+// triangle that covers a pixel centre of the tile.
+constexpr double RECT_PAD = 1e-6;
+
+struct Square {
+    double x0, y0, x1, y1;
+};
+
+bool meets(const ClusterView& c, const Square& s) {
+    return c.rect.x <= s.x1 && c.rect.z >= s.x0 && c.rect.y <= s.y1 && c.rect.w >= s.y0;
+}
+
+// Fraction of [a0, a1] inside [b0, b1] (a point: 1 inside, 0 outside).
+double fraction1D(double a0, double a1, double b0, double b1) {
+    if (a1 - a0 < 1e-15) return a0 >= b0 && a0 < b1 ? 1.0 : 0.0;
+    return std::max(0.0, std::min(a1, b1) - std::max(a0, b0)) / (a1 - a0);
+}
+
+// Expected fragments of the clusters `ids` inside `s` at `pixelSize`.
+double predict(const std::vector<ClusterView>& views, const std::vector<uint32_t>& ids, const Square& s,
+               double pixelSizeRoot, double rootSize) {
+    double area = 0;
+    for (uint32_t i : ids) {
+        const ClusterView& c = views[i];
+        // the rectangle without its pad, so a cluster split between tiles is shared out exactly
+        area += c.projectedArea * fraction1D(c.rect.x + RECT_PAD, c.rect.z - RECT_PAD, s.x0, s.x1) *
+                fraction1D(c.rect.y + RECT_PAD, c.rect.w - RECT_PAD, s.y0, s.y1);
+    }
+    const double pixel = pixelSizeRoot * rootSize;
+    return area / (pixel * pixel);
+}
+
+std::vector<uint32_t> filter(const std::vector<ClusterView>& views, const std::vector<uint32_t>& ids, const Square& s) {
+    std::vector<uint32_t> out;
+    for (uint32_t i : ids)
+        if (meets(views[i], s)) out.push_back(i);
+    return out;
+}
+
+Square windowSquare(const BundleLeaf& leaf, const TileWindow& w) {
+    const double step = leaf.extent / leaf.pixels;
+    return {leaf.min.x + w.x * step, leaf.min.y + w.y * step, leaf.min.x + (w.x + w.width) * step,
+            leaf.min.y + (w.y + w.height) * step};
+}
+
+struct QuadtreeBuilder {
+    const std::vector<Cluster>& clusters;
+    const std::vector<ClusterView>& views;
+    double rootSize;
+    const TilerOptions& o;
+    std::vector<BundleLeaf> leaves;
+    std::vector<std::vector<uint32_t>> leafClusters;
+
+    // Pixels across a node of `extent` whose largest importance is `imax`.
+    int pixelsFor(double extent, float imax) const {
+        double side = extent * rootSize;
+        double p = o.fixedPixelSize > 0 ? o.fixedPixelSize : 1.0 / (o.pixelsPerTexel * std::sqrt(double(imax)));
+        return int(std::max(1.0, std::ceil(side / p - 1e-9)));
+    }
+
+    float maxImportance(const std::vector<uint32_t>& ids) const {
+        float m = 0;
+        for (uint32_t i : ids) m = std::max(m, clusters[i].maxImportance);
+        return m;
+    }
+
+    void build(glm::dvec2 min, double extent, int depth, const std::vector<uint32_t>& candidates) {
+        const Square s{min.x, min.y, min.x + extent, min.y + extent};
+        std::vector<uint32_t> ids = filter(views, candidates, s);
+        const float imax = maxImportance(ids);
+        if (imax <= 0.0f) return;  // no texel centre here: nothing to update
+        const int pixels = pixelsFor(extent, imax);
+        if (depth < o.maxDepth && pixels > 1) {
+            bool split = pixels > o.maxLeafPixels;
+            if (!split && o.fixedPixelSize <= 0 && pixels >= 64) {
+                // split where the quarters need coarser pixels and that saves a third of the fragments
+                const double here = predict(views, ids, s, extent / pixels, rootSize);
+                double quarters = 0;
+                for (int k = 0; k < 4; ++k) {
+                    const double h = 0.5 * extent;
+                    Square q{min.x + (k & 1) * h, min.y + (k >> 1) * h, min.x + (k & 1) * h + h, min.y + (k >> 1) * h + h};
+                    std::vector<uint32_t> sub = filter(views, ids, q);
+                    float qmax = maxImportance(sub);
+                    if (qmax > 0) quarters += predict(views, sub, q, h / pixelsFor(h, qmax), rootSize);
+                }
+                split = quarters < (2.0 / 3.0) * here;
+            }
+            if (split) {
+                const double h = 0.5 * extent;
+                for (int k = 0; k < 4; ++k)
+                    build(min + glm::dvec2((k & 1) * h, (k >> 1) * h), h, depth + 1, ids);
+                return;
+            }
+        }
+        leaves.push_back({min, extent, pixels});
+        leafClusters.push_back(std::move(ids));
+    }
+};
+
+}  // namespace
+
+std::vector<Cluster> clusterMesh(BakeMesh& mesh, uint32_t maxTriangles) {
+    CHECK_GE(maxTriangles, 1u);
+    const size_t n = mesh.triangles.size();
+    std::vector<glm::vec3> centroid(n);
+    for (size_t t = 0; t < n; ++t)
+        centroid[t] = (glm::vec3(mesh.vertices[3 * t].position) + glm::vec3(mesh.vertices[3 * t + 1].position) +
+                       glm::vec3(mesh.vertices[3 * t + 2].position)) / 3.0f;
+    std::vector<uint32_t> order(n);
+    std::iota(order.begin(), order.end(), 0u);
+    std::vector<std::pair<uint32_t, uint32_t>> ranges;  // [begin, end) of order per cluster
+
+    // median split along the longest axis of the centroids' bounds
+    auto split = [&](auto&& self, uint32_t begin, uint32_t end) -> void {
+        if (end - begin <= maxTriangles) {
+            ranges.push_back({begin, end});
+            return;
+        }
+        glm::vec3 lo(3e38f), hi(-3e38f);
+        for (uint32_t i = begin; i < end; ++i) {
+            lo = glm::min(lo, centroid[order[i]]);
+            hi = glm::max(hi, centroid[order[i]]);
+        }
+        glm::vec3 e = hi - lo;
+        int axis = e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
+        uint32_t mid = begin + (end - begin) / 2;
+        std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end, [&](uint32_t a, uint32_t b) {
+            float ca = centroid[a][axis], cb = centroid[b][axis];
+            return ca != cb ? ca < cb : a < b;
+        });
+        self(self, begin, mid);
+        self(self, mid, end);
+    };
+    for (size_t p = 0; p + 1 < mesh.pageFirstTriangle.size(); ++p)
+        if (mesh.pageFirstTriangle[p + 1] > mesh.pageFirstTriangle[p])
+            split(split, mesh.pageFirstTriangle[p], mesh.pageFirstTriangle[p + 1]);
+
+    // reorder triangles and vertices
+    std::vector<BakeTriangle> triangles(n);
+    std::vector<BakeVertex> vertices(3 * n);
+    for (size_t i = 0; i < n; ++i) {
+        triangles[i] = mesh.triangles[order[i]];
+        for (int k = 0; k < 3; ++k) vertices[3 * i + k] = mesh.vertices[3 * size_t(order[i]) + k];
+    }
+    mesh.triangles = std::move(triangles);
+    mesh.vertices = std::move(vertices);
+
+    std::vector<Cluster> clusters;
+    clusters.reserve(ranges.size());
+    for (auto [begin, end] : ranges) {
+        Cluster c;
+        c.first = begin;
+        c.count = end - begin;
+        c.page = mesh.triangles[begin].page;
+        c.boundsMin = glm::vec3(3e38f);
+        c.boundsMax = glm::vec3(-3e38f);
+        for (uint32_t v = 3 * begin; v < 3 * end; ++v) {
+            c.boundsMin = glm::min(c.boundsMin, glm::vec3(mesh.vertices[v].position));
+            c.boundsMax = glm::max(c.boundsMax, glm::vec3(mesh.vertices[v].position));
+        }
+        clusters.push_back(c);
+    }
+    return clusters;
+}
+
+void setClusterImportance(std::vector<Cluster>& clusters, const std::vector<float>& importance) {
+    for (Cluster& c : clusters) {
+        c.maxImportance = 0.0f;
+        for (uint32_t t = c.first; t < c.first + c.count; ++t) c.maxImportance = std::max(c.maxImportance, importance[t]);
+    }
+}
+
+std::vector<ClusterView> projectClusters(const BakeMesh& mesh, const std::vector<Cluster>& clusters,
+                                         const BundleFrame& f) {
+    std::vector<ClusterView> views(clusters.size());
+    const glm::dvec3 d(f.dir), u(f.u), v(f.v);
+    for (size_t i = 0; i < clusters.size(); ++i) {
+        const Cluster& c = clusters[i];
+        glm::dvec2 lo(1e300), hi(-1e300);
+        for (int k = 0; k < 8; ++k) {
+            glm::dvec3 p((k & 1) ? c.boundsMax.x : c.boundsMin.x, (k & 2) ? c.boundsMax.y : c.boundsMin.y,
+                         (k & 4) ? c.boundsMax.z : c.boundsMin.z);
+            glm::dvec2 q((glm::dot(p, u) - f.origin.x) / f.size, (glm::dot(p, v) - f.origin.y) / f.size);
+            lo = glm::min(lo, q);
+            hi = glm::max(hi, q);
+        }
+        views[i].rect = glm::dvec4(lo.x - RECT_PAD, lo.y - RECT_PAD, hi.x + RECT_PAD, hi.y + RECT_PAD);
+        double area = 0;
+        for (uint32_t t = c.first; t < c.first + c.count; ++t) {
+            glm::dvec3 a(mesh.vertices[3 * size_t(t)].position), b(mesh.vertices[3 * size_t(t) + 1].position),
+                cc(mesh.vertices[3 * size_t(t) + 2].position);
+            area += 0.5 * std::abs(glm::dot(glm::cross(b - a, cc - a), d));
+        }
+        views[i].projectedArea = area;
+    }
+    return views;
+}
+
+Tile makeTile(const DirectionTiling& tiling, int leaf, const TileWindow& window, const std::vector<Cluster>& clusters,
+              const std::vector<ClusterView>& views, const std::vector<uint32_t>& candidates, bool cull) {
+    const BundleLeaf& l = tiling.leaves[size_t(leaf)];
+    const Square s = windowSquare(l, window);
+    Tile t;
+    t.leaf = leaf;
+    t.window = window;
+    std::vector<uint32_t> met = filter(views, candidates, s);
+    t.predictedNodes = predict(views, met, s, l.extent / l.pixels, tiling.sceneSize);
+    if (cull) {
+        t.clusters = std::move(met);
+    } else {
+        t.clusters.resize(clusters.size());
+        std::iota(t.clusters.begin(), t.clusters.end(), 0u);
+    }
+    return t;
+}
+
+std::vector<TileWindow> splitWindow(const TileWindow& w) {
+    std::vector<TileWindow> out;
+    const int hw = std::max(1, w.width / 2), hh = std::max(1, w.height / 2);
+    for (int k = 0; k < 4; ++k) {
+        TileWindow q{w.x + (k & 1) * hw, w.y + (k >> 1) * hh, (k & 1) ? w.width - hw : hw, (k >> 1) ? w.height - hh : hh};
+        if (q.width > 0 && q.height > 0) out.push_back(q);
+    }
+    return out;
+}
+
+DirectionTiling tileBundle(const std::vector<Cluster>& clusters, const std::vector<ClusterView>& views, double rootSize,
+                           const TilerOptions& o) {
+    CHECK_EQ(clusters.size(), views.size());
+    DirectionTiling tiling;
+    tiling.sceneSize = rootSize;
+    std::vector<uint32_t> all(clusters.size());
+    std::iota(all.begin(), all.end(), 0u);
+
+    QuadtreeBuilder qb{clusters, views, rootSize, o, {}, {}};
+    if (o.uniform) {
+        CHECK_GT(o.fixedPixelSize, 0.0);
+        qb.leaves.push_back({glm::dvec2(0.0), 1.0, qb.pixelsFor(1.0, 1.0f)});
+        qb.leafClusters.push_back(all);
+    } else {
+        qb.build(glm::dvec2(0.0), 1.0, 0, all);
+    }
+    tiling.leaves = std::move(qb.leaves);
+
+    // windows: at most maxTilePixels across, split until the prediction fits
+    for (size_t l = 0; l < tiling.leaves.size(); ++l) {
+        const int w = tiling.leaves[l].pixels;
+        const int step = std::min(w, o.maxTilePixels);
+        std::vector<TileWindow> work;
+        for (int y = w - (w - 1) % step - 1; y >= 0; y -= step)  // reverse, so popping from the back goes in row order
+            for (int x = w - (w - 1) % step - 1; x >= 0; x -= step)
+                work.push_back({x, y, std::min(step, w - x), std::min(step, w - y)});
+        while (!work.empty()) {
+            TileWindow win = work.back();
+            work.pop_back();
+            Tile t = makeTile(tiling, int(l), win, clusters, views, qb.leafClusters[l], o.cull);
+            if (t.predictedNodes > o.fill * o.nodeCapacity && (win.width > 1 || win.height > 1)) {
+                auto quarters = splitWindow(win);
+                for (auto it = quarters.rbegin(); it != quarters.rend(); ++it) work.push_back(*it);
+                continue;
+            }
+            tiling.tiles.push_back(std::move(t));
+        }
+    }
+    return tiling;
+}
+
+void clusterRanges(const std::vector<Cluster>& clusters, const std::vector<uint32_t>& tileClusters,
+                   std::vector<int32_t>& firstVertex, std::vector<int32_t>& vertexCount) {
+    firstVertex.clear();
+    vertexCount.clear();
+    for (uint32_t i : tileClusters) {
+        const Cluster& c = clusters[i];
+        if (!firstVertex.empty() && uint32_t(firstVertex.back() + vertexCount.back()) == 3 * c.first)
+            vertexCount.back() += int32_t(3 * c.count);
+        else {
+            firstVertex.push_back(int32_t(3 * c.first));
+            vertexCount.push_back(int32_t(3 * c.count));
+        }
+    }
+}
+
+}  // namespace bb
