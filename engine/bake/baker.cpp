@@ -986,7 +986,7 @@ uint64_t fnv1a(const void* data, size_t bytes, uint64_t h = 1469598103934665603u
 uint64_t checkpointKey(const BakeMesh& mesh, const Layout& layout, const BakeOptions& o, double historyPower) {
     uint64_t h = fnv1a(mesh.vertices.data(), mesh.vertices.size() * sizeof(BakeVertex));
     h = fnv1a(mesh.triangles.data(), mesh.triangles.size() * sizeof(BakeTriangle), h);
-    const int64_t ints[] = {layout.resolution, layout.pageCount, o.directions, o.bundleResolution, o.memoryBudget,
+    const int64_t ints[] = {layout.resolution, layout.pageCount, o.directions, o.bundleResolution, o.memoryBudget, int64_t(o.tiling),
                             int64_t(o.seed), int64_t(o.rounding), o.sunJitter, o.environment ? 1 : 0};
     h = fnv1a(ints, sizeof ints, h);
     const double reals[] = {o.sky.r, o.sky.g, o.sky.b, historyPower};

@@ -14,8 +14,9 @@
 namespace bb::io {
 
 // A linear RGB float image, row-major, row 0 = top of the file (as EXR/PNG store
-// it). Light map pages are stored with texel row 0 (v = 0) at the *bottom*:
-// callers flip with flipRows() when going between GL order and file order.
+// it). Every light-map-space image bundlebake writes (light maps, importance)
+// keeps texel row 0 (v = 0, GL's first row) as file row 0: glTF puts v = 0 at
+// the top of an image, so the files read as the scene's UVs do.
 struct ImageRgb {
     int width = 0, height = 0;
     std::vector<glm::vec3> pixels;

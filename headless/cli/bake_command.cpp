@@ -28,6 +28,14 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
                    "Uniform bundle resolution in pixels across the scene's bounding sphere (0 = half a light map texel per pixel)")
         ->check(CLI::Range(0, 1 << 20))
         ->capture_default_str();
+    cmd.add_option("--tiling", a.tiling,
+                   "Bundle tiles: adaptive (quadtree, each leaf's pixel from the importance of what it covers) or uniform "
+                   "(one grid at the mean texel density, the Hermes et al. 2010 baseline)")
+        ->check(CLI::IsMember({"adaptive", "uniform"}))
+        ->capture_default_str();
+    cmd.add_option("--culling", a.culling, "Per-tile cluster culling in the bundle and update passes: on or off")
+        ->check(CLI::IsMember({"on", "off"}))
+        ->capture_default_str();
     cmd.add_option("--memory-budget", a.memoryBudget, "GPU bytes for one tile's node buffer and head image (e.g. 512M, 2G)")
         ->capture_default_str();
     cmd.add_option("--seed", a.seed, "Random seed (directions, stochastic rounding)")->capture_default_str();
@@ -74,6 +82,8 @@ int runBake(const BakeArgs& args) {
     BakeOptions options;
     options.directions = args.directions;
     options.bundleResolution = args.bundleRes;
+    options.tiling = args.tiling == "uniform" ? BakeOptions::Tiling::Uniform : BakeOptions::Tiling::Adaptive;
+    options.cull = args.culling == "on";
     options.memoryBudget = *budget;
     options.seed = args.seed;
     options.sky = *sky;
@@ -116,7 +126,7 @@ int runBake(const BakeArgs& args) {
     BakeOutputInfo info;
     info.backend = backendName(*backend);
     info.renderer = context.value()->caps().renderer;
-    info.settings = {{"directions", args.directions}, {"bundle_res", args.bundleRes}, {"memory_budget", args.memoryBudget},
+    info.settings = {{"directions", args.directions}, {"bundle_res", args.bundleRes}, {"tiling", args.tiling}, {"culling", args.culling}, {"memory_budget", args.memoryBudget},
                      {"seed", args.seed}, {"sky", args.sky}, {"env", args.env}, {"rounding", args.rounding},
                      {"uv_layout", args.scene.uvLayout}, {"resolution", args.scene.resolution},
                      {"texel_density", args.scene.texelDensity}, {"history_power", (*baker)->stats().historyPower},

@@ -107,9 +107,7 @@ int runImportance(const ImportanceArgs& args) {
             png.pixels[i] = v > 0.0f ? falseColour(logSpan > 0.0 ? float((std::log10(double(v)) - logMin) / logSpan) : 0.5f)
                                      : glm::vec3(1.0f, 0.0f, 1.0f);
         }
-        // GL order (row 0 = v = 0) to file order (row 0 = top)
-        io::flipRows(exr);
-        io::flipRows(png);
+        // row 0 = v = 0, as the light maps (glTF: v runs down from the top of an image)
         const std::string stem = "importance_" + std::to_string(p);
         char scaleText[32];
         std::snprintf(scaleText, sizeof(scaleText), "%.9g", double(scale));

@@ -35,6 +35,8 @@ struct BakeArgs {
     std::string backend = "egl";
     int directions = 256;
     int bundleRes = 0;                // 0 = from the layout's texel density
+    std::string tiling = "adaptive";  // adaptive | uniform
+    std::string culling = "on";       // on | off
     std::string memoryBudget = "512M";
     uint64_t seed = 1;
     std::string sky = "0,0,0";

@@ -33,6 +33,8 @@
 #include "importance/importance_gl.h"
 #include "layout/layout.h"
 #include "scene/scene.h"
+#include "io/image_io.h"
+#include "support/bake_helper.h"
 #include "support/gl_fixture.h"
 #include "support/importance_meshes.h"
 
@@ -542,6 +544,42 @@ TEST(ImportanceCli, WritesMapsJsonAndPrintsTheDistribution) {
     EXPECT_GT(j["png"]["log10_max"].get<double>(), j["png"]["log10_min"].get<double>() - 1e-9);
     for (const auto& entry : fs::directory_iterator(dir))
         EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();
+}
+
+// Every light-map-space image uses one row order: the importance map's
+// mapped texels (I(t) > 0 wherever a triangle covers a texel centre) are
+// exactly the light map's covered texels, row for row, in the files.
+TEST(ImportanceCli, MappedTexelsAreTheLightMapsCoveredTexels) {
+    BB_REQUIRE_GL();
+    namespace fs = std::filesystem;
+    const std::string dir = ::testing::TempDir() + "/importance_rows_" + std::to_string(::getpid());
+    fs::remove_all(dir);
+    CliRun r = runCli(test::sourcePath("assets/cornell_box/cornell_box.gltf") + " --uv-layout asset --resolution 64 -o " + dir);
+    ASSERT_EQ(r.status, 0) << r.err;
+    auto importance = io::readImageRgb(dir + "/importance_0.exr");
+    ASSERT_TRUE(importance) << importance.error();
+
+    BakeOptions options;
+    options.directions = 1;
+    auto bake = test::makeBake("assets/cornell_box/cornell_box.gltf", test::assetLayout(64), options);
+    ASSERT_TRUE(bake) << bake.error;
+    const LightmapPages maps = bake.baker->readLightmaps();
+    ASSERT_EQ(maps.resolution, importance->width);
+    ASSERT_EQ(maps.resolution, importance->height);
+    const int res = maps.resolution;
+    int64_t covered = 0, mismatched = 0, mismatchedIfFlipped = 0;
+    for (int y = 0; y < res; ++y)
+        for (int x = 0; x < res; ++x) {
+            const bool c = maps.covered[0][size_t(y) * res + x] != 0;
+            covered += c;
+            mismatched += c != (importance->pixels[size_t(y) * res + x].r > 0.0f);
+            mismatchedIfFlipped += c != (importance->pixels[size_t(res - 1 - y) * res + x].r > 0.0f);
+        }
+    EXPECT_GT(covered, res * res / 4);
+    EXPECT_EQ(mismatched, 0) << "of " << covered << " covered texels";
+    // the check can fail: the Cornell box atlas is not symmetric top to bottom
+    EXPECT_GT(mismatchedIfFlipped, covered / 20);
+    fs::remove_all(dir);
 }
 
 TEST(ImportanceCli, BadInputIsOneLineAndNonZero) {
