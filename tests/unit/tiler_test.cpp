@@ -1,0 +1,241 @@
+// Tiling with memory usage prediction (engine/tiler), without GL: clusters,
+// the importance-driven quadtree, the node prediction against an exact count
+// of pixel centres, and the budget-independence of the leaves.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "tiler/tiler.h"
+
+namespace bb {
+namespace {
+
+// n x n quads (2 triangles each) over [x0, x0 + size] x [y0, y0 + size] at
+// height z, facing +z, on `page`.
+void addGrid(BakeMesh& mesh, float x0, float y0, float z, float size, int n, uint32_t page) {
+    const float step = size / n;
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            glm::vec3 a(x0 + i * step, y0 + j * step, z), b = a + glm::vec3(step, 0, 0), c = a + glm::vec3(step, step, 0),
+                                                        d = a + glm::vec3(0, step, 0);
+            const glm::vec3 corners[2][3] = {{a, b, c}, {a, c, d}};
+            for (const auto& t : corners) {
+                for (const glm::vec3& p : t) {
+                    BakeVertex v{};
+                    v.position = glm::vec4(p, 1.0f);
+                    v.normal = glm::vec4(0, 0, 1, 0);
+                    mesh.vertices.push_back(v);
+                }
+                mesh.triangles.push_back(BakeTriangle{0, page, 0, 0});
+                mesh.bounds.extend(t[0]);
+                mesh.bounds.extend(t[1]);
+                mesh.bounds.extend(t[2]);
+            }
+        }
+}
+
+void finishPages(BakeMesh& mesh, uint32_t pages) {
+    mesh.pageFirstTriangle.assign(pages + 1, 0);
+    for (const BakeTriangle& t : mesh.triangles) ++mesh.pageFirstTriangle[t.page + 1];
+    for (uint32_t p = 0; p < pages; ++p) mesh.pageFirstTriangle[p + 1] += mesh.pageFirstTriangle[p];
+}
+
+// Looking straight down -z over the square [-h, h]^2 (root units map it to [0, 1]^2).
+BundleFrame downFrame(double half) {
+    BundleFrame f;
+    f.dir = glm::vec3(0, 0, -1);
+    f.u = glm::vec3(1, 0, 0);
+    f.v = glm::vec3(0, -1, 0);  // u x v = d
+    f.origin = glm::dvec2(-half, -half);
+    f.size = 2 * half;
+    return f;
+}
+
+TEST(Tiler, ClustersAreAPermutationWithinPagesAndBoundTheirTriangles) {
+    BakeMesh mesh;
+    addGrid(mesh, 0, 0, 0, 10, 20, 0);   // 800 triangles on page 0
+    addGrid(mesh, 0, 0, 1, 10, 10, 1);   // 200 on page 1
+    finishPages(mesh, 2);
+    std::multiset<std::tuple<float, float, float>> before;
+    for (const auto& v : mesh.vertices) before.insert({v.position.x, v.position.y, v.position.z});
+    const auto clusters = clusterMesh(mesh, 64);
+    std::multiset<std::tuple<float, float, float>> after;
+    for (const auto& v : mesh.vertices) after.insert({v.position.x, v.position.y, v.position.z});
+    EXPECT_EQ(before, after);
+    uint32_t next = 0;
+    for (const Cluster& c : clusters) {
+        EXPECT_EQ(c.first, next);  // contiguous, in order
+        EXPECT_LE(c.count, 64u);
+        EXPECT_GE(c.count, 1u);
+        next = c.first + c.count;
+        for (uint32_t t = c.first; t < next; ++t) {
+            EXPECT_EQ(mesh.triangles[t].page, c.page);
+            for (int k = 0; k < 3; ++k) {
+                glm::vec3 p(mesh.vertices[3 * t + k].position);
+                EXPECT_TRUE(glm::all(glm::greaterThanEqual(p, c.boundsMin)) && glm::all(glm::lessThanEqual(p, c.boundsMax)));
+            }
+        }
+    }
+    EXPECT_EQ(next, 1000u);
+    EXPECT_EQ(mesh.pageFirstTriangle[1], 800u);
+    // spatially coherent: a cluster of 50 of the 0.5-unit quads spans far less than the 10-unit grid
+    for (const Cluster& c : clusters) EXPECT_LT(glm::length(c.boundsMax - c.boundsMin), 8.0f);
+}
+
+// Counts pixel centres of a leaf's grid inside the triangles: what the raster makes.
+double exactFragments(const BakeMesh& mesh, const BundleFrame& f, const BundleLeaf& leaf, const TileWindow& w) {
+    double n = 0;
+    const double pixel = leaf.extent * f.size / leaf.pixels;
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+        glm::dvec2 p[3];
+        for (int k = 0; k < 3; ++k) {
+            glm::dvec3 x(mesh.vertices[3 * t + k].position);
+            p[k] = glm::dvec2(glm::dot(x, glm::dvec3(f.u)) - f.origin.x, glm::dot(x, glm::dvec3(f.v)) - f.origin.y);
+        }
+        for (int y = w.y; y < w.y + w.height; ++y)
+            for (int x = w.x; x < w.x + w.width; ++x) {
+                glm::dvec2 c(leaf.min.x * f.size + (x + 0.5) * pixel, leaf.min.y * f.size + (y + 0.5) * pixel);
+                auto edge = [](glm::dvec2 a, glm::dvec2 b, glm::dvec2 q) { return (b.x - a.x) * (q.y - a.y) - (b.y - a.y) * (q.x - a.x); };
+                double e0 = edge(p[0], p[1], c), e1 = edge(p[1], p[2], c), e2 = edge(p[2], p[0], c);
+                if ((e0 >= 0 && e1 >= 0 && e2 >= 0) || (e0 <= 0 && e1 <= 0 && e2 <= 0)) n += 1;
+            }
+    }
+    return n;
+}
+
+TEST(Tiler, LeavesFollowImportanceAndPartitionTheRoot) {
+    // a sparse 100-unit plane (1 texel per unit) with a dense 4-unit patch (16 texels per unit) above it
+    BakeMesh mesh;
+    addGrid(mesh, -50, -50, 0, 100, 8, 0);
+    addGrid(mesh, 10, 10, 5, 4, 8, 0);
+    finishPages(mesh, 1);
+    auto clusters = clusterMesh(mesh, 16);
+    std::vector<float> importance(mesh.triangles.size());
+    for (size_t t = 0; t < importance.size(); ++t) importance[t] = mesh.vertices[3 * t].position.z > 1 ? 256.0f : 1.0f;
+    setClusterImportance(clusters, importance);
+    const BundleFrame frame = downFrame(72);
+    const auto views = projectClusters(mesh, clusters, frame);
+    TilerOptions o;
+    o.maxLeafPixels = 256;
+    const DirectionTiling tiling = tileBundle(clusters, views, frame.size, o);
+
+    ASSERT_GT(tiling.leaves.size(), 1u);
+    double area = 0, finest = 1e9, coarsest = 0;
+    for (size_t i = 0; i < tiling.leaves.size(); ++i) {
+        const BundleLeaf& a = tiling.leaves[i];
+        area += a.extent * a.extent;
+        EXPECT_LE(a.pixels, o.maxLeafPixels);
+        finest = std::min(finest, tiling.pixelSize(int(i)));
+        coarsest = std::max(coarsest, tiling.pixelSize(int(i)));
+        for (size_t j = i + 1; j < tiling.leaves.size(); ++j) {  // no two leaves overlap
+            const BundleLeaf& b = tiling.leaves[j];
+            bool apart = a.min.x + a.extent <= b.min.x || b.min.x + b.extent <= a.min.x || a.min.y + a.extent <= b.min.y ||
+                         b.min.y + b.extent <= a.min.y;
+            EXPECT_TRUE(apart) << i << " " << j;
+        }
+    }
+    EXPECT_LE(area, 1.0 + 1e-12);
+    // the half-texel rule where the dense patch is, coarse pixels on the plane
+    EXPECT_LE(finest, 1.0 / (2.0 * 16.0) + 1e-9);
+    EXPECT_GE(coarsest, 4 * finest);
+    // every pixel centre that a triangle covers lies in exactly one leaf: the
+    // leaves cover every cluster with texels
+    for (size_t c = 0; c < clusters.size(); ++c) {
+        glm::dvec2 centre(0.5 * (views[c].rect.x + views[c].rect.z), 0.5 * (views[c].rect.y + views[c].rect.w));
+        int owners = 0;
+        for (const BundleLeaf& l : tiling.leaves)
+            owners += centre.x >= l.min.x && centre.x < l.min.x + l.extent && centre.y >= l.min.y && centre.y < l.min.y + l.extent;
+        EXPECT_EQ(owners, 1) << "cluster " << c;
+    }
+}
+
+TEST(Tiler, PredictionMatchesTheRasterAndTilesFitTheBudget) {
+    BakeMesh mesh;
+    // offsets keep pixel centres off the triangle edges, where this count would see them twice
+    addGrid(mesh, -49.9871f, -50.0133f, 0, 100, 16, 0);
+    addGrid(mesh, -20.0071f, -9.9913f, 3, 30, 12, 0);  // a second layer: depth complexity 2 where they overlap
+    finishPages(mesh, 1);
+    auto clusters = clusterMesh(mesh, 32);
+    setClusterImportance(clusters, std::vector<float>(mesh.triangles.size(), 0.09f));  // 0.3 texels per unit
+    const BundleFrame frame = downFrame(60);
+    const auto views = projectClusters(mesh, clusters, frame);
+    TilerOptions o;
+    o.nodeCapacity = 3000;
+    o.maxTilePixels = 128;
+    const DirectionTiling tiling = tileBundle(clusters, views, frame.size, o);
+    ASSERT_GT(tiling.tiles.size(), 2u);
+    double predicted = 0, exact = 0;
+    for (const Tile& t : tiling.tiles) {
+        EXPECT_LE(t.predictedNodes, o.fill * o.nodeCapacity);
+        EXPECT_LE(std::max(t.window.width, t.window.height), o.maxTilePixels);
+        const double n = exactFragments(mesh, frame, tiling.leaves[size_t(t.leaf)], t.window);
+        predicted += t.predictedNodes;
+        exact += n;
+        if (n > 200) EXPECT_NEAR(t.predictedNodes / n, 1.0, 0.35) << "tile " << t.window.x << "," << t.window.y;
+    }
+    EXPECT_NEAR(predicted / exact, 1.0, 0.02);
+}
+
+TEST(Tiler, LeavesDoNotDependOnTheBudgetButTilesDo) {
+    BakeMesh mesh;
+    addGrid(mesh, -50, -50, 0, 100, 16, 0);
+    addGrid(mesh, 0, 0, 2, 8, 8, 0);
+    finishPages(mesh, 1);
+    auto clusters = clusterMesh(mesh, 32);
+    std::vector<float> importance(mesh.triangles.size());
+    for (size_t t = 0; t < importance.size(); ++t) importance[t] = mesh.vertices[3 * t].position.z > 1 ? 64.0f : 0.25f;
+    setClusterImportance(clusters, importance);
+    const BundleFrame frame = downFrame(72);
+    const auto views = projectClusters(mesh, clusters, frame);
+    TilerOptions roomy, tight;
+    tight.nodeCapacity = 500;
+    tight.maxTilePixels = 64;
+    const DirectionTiling a = tileBundle(clusters, views, frame.size, roomy);
+    const DirectionTiling b = tileBundle(clusters, views, frame.size, tight);
+    ASSERT_EQ(a.leaves.size(), b.leaves.size());
+    for (size_t i = 0; i < a.leaves.size(); ++i) {
+        EXPECT_EQ(a.leaves[i].min, b.leaves[i].min);
+        EXPECT_EQ(a.leaves[i].extent, b.leaves[i].extent);
+        EXPECT_EQ(a.leaves[i].pixels, b.leaves[i].pixels);
+    }
+    EXPECT_GT(b.tiles.size(), a.tiles.size());
+    // the tight tiles cover each leaf's grid exactly once
+    for (size_t l = 0; l < b.leaves.size(); ++l) {
+        int64_t pixels = 0;
+        for (const Tile& t : b.tiles)
+            if (t.leaf == int(l)) pixels += int64_t(t.window.width) * t.window.height;
+        EXPECT_EQ(pixels, int64_t(b.leaves[l].pixels) * b.leaves[l].pixels) << "leaf " << l;
+    }
+}
+
+TEST(Tiler, CullingKeepsOnlyClustersThatMeetTheTile) {
+    BakeMesh mesh;
+    addGrid(mesh, -50, -50, 0, 100, 32, 0);
+    finishPages(mesh, 1);
+    auto clusters = clusterMesh(mesh, 16);
+    setClusterImportance(clusters, std::vector<float>(mesh.triangles.size(), 1.0f));
+    const BundleFrame frame = downFrame(60);
+    const auto views = projectClusters(mesh, clusters, frame);
+    TilerOptions o;
+    o.maxLeafPixels = 64;
+    const DirectionTiling culled = tileBundle(clusters, views, frame.size, o);
+    o.cull = false;
+    const DirectionTiling all = tileBundle(clusters, views, frame.size, o);
+    ASSERT_EQ(culled.tiles.size(), all.tiles.size());
+    size_t drawnCulled = 0, drawnAll = 0;
+    for (size_t i = 0; i < culled.tiles.size(); ++i) {
+        drawnCulled += culled.tiles[i].clusters.size();
+        drawnAll += all.tiles[i].clusters.size();
+        EXPECT_EQ(culled.tiles[i].predictedNodes, all.tiles[i].predictedNodes);
+    }
+    EXPECT_LT(drawnCulled * 4, drawnAll);
+    std::vector<int32_t> first, count;
+    clusterRanges(clusters, all.tiles[0].clusters, first, count);
+    ASSERT_EQ(first.size(), 1u);  // every cluster: one merged range
+    EXPECT_EQ(count[0], int32_t(3 * mesh.triangles.size()));
+}
+
+}  // namespace
+}  // namespace bb
