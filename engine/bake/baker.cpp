@@ -109,6 +109,7 @@ struct Baker::Impl {
     int64_t nodeCapacity = 0;     // nodes the budget allows in one tile
     int64_t nodeAllocated = 0;    // nodes the buffer holds now (grown from the predictions)
     int headSide = 0;             // the head image's side now (grown to the largest tile)
+    int subpixelBits = 8;         // GL_SUBPIXEL_BITS
 
     Status init(const Scene& scene);
     Status buildPrograms();
@@ -344,6 +345,8 @@ Status Baker::Impl::init(const Scene& scene) {
     GLint vp[2] = {0, 0};
     glGetIntegerv(GL_MAX_VIEWPORT_DIMS, vp);
     const int maxViewport = std::min(vp[0], vp[1]);
+    glGetIntegerv(GL_SUBPIXEL_BITS, &subpixelBits);
+    subpixelBits = std::clamp(subpixelBits, 0, 12);
     if (options.tiling == BakeOptions::Tiling::Uniform && gridSize > maxViewport)
         return Status::error("the bundle would be " + std::to_string(gridSize) + " pixels across, beyond GL_MAX_VIEWPORT_DIMS " +
                              std::to_string(maxViewport) + "; use --tiling adaptive, or lower --bundle-res, --resolution or --texel-density");
@@ -586,13 +589,19 @@ void Baker::Impl::traceBundle(const glm::vec3& d, glm::vec2 jitter, uint32_t see
             glUniform1ui(appendProgram.uniform("nodeCapacity"), uint32_t(nodeAllocated));
             glUniform1ui(appendProgram.uniform("randomSeed"), f.leafSeed);
             glBindFramebuffer(GL_FRAMEBUFFER, bundleFbo.id());
-            // the leaf's grid with its viewport shifted so the tile lands at (0, 0); the scissor keeps the rest out
-            glViewport(-tile.window.x, -tile.window.y, f.leaf.pixels, f.leaf.pixels);
+            // the leaf's grid in a power-of-two viewport (glsl/bundle/append.vert) shifted so the
+            // tile lands at (0, 0); the scissor keeps the rest out
+            int viewportPixels = 1;
+            while (viewportPixels < f.leaf.pixels) viewportPixels *= 2;
+            glUniform1i(appendProgram.uniform("viewportPixels"), viewportPixels);
+            glUniform1f(appendProgram.uniform("subpixelSteps"), float(1 << subpixelBits));
+            glViewport(-tile.window.x, -tile.window.y, viewportPixels, viewportPixels);
             glEnable(GL_SCISSOR_TEST);
             glScissor(0, 0, tile.window.width, tile.window.height);
             glBindVertexArray(vao.id());
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, triangleBuffer.id());
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_NODES, nodeBuffer.id());
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_VERTICES, vertexBuffer.id());
             glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, BINDING_NODE_COUNTER, counterBuffer.id());
             glBindImageTexture(BINDING_HEADS, heads.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
             glBindTextureUnit(BINDING_RADIANCE, radiance.id());

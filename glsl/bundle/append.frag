@@ -7,8 +7,9 @@
 #include "lib/rounding.glsl"
 #include "lib/bundle_frame.glsl"
 
-in vec2 vLightmapUv;
-in float vDepth;
+flat in vec3 vDepthPlane;
+flat in vec3 vUPlane;
+flat in vec3 vVPlane;
 flat in uint vPage;
 flat in uint vFlags;
 flat in vec3 vFaceNormal;
@@ -27,7 +28,10 @@ void main() {
     if (index >= nodeCapacity) return;  // overflow: the host sees counter > capacity and redraws split
     ivec2 pixel = ivec2(gl_FragCoord.xy);  // in the tile (the head image)
     ivec2 leafPixel = pixel + tileOffset;
-    vec3 lo = textureLod(radiance, vec3(vLightmapUv, float(vPage)), 0.0).rgb;
+    vec2 centre = vec2(leafPixel) + 0.5;
+    float depth = dot(vDepthPlane.xy, centre) + vDepthPlane.z;
+    vec2 lightmapUv = vec2(dot(vUPlane.xy, centre) + vUPlane.z, dot(vVPlane.xy, centre) + vVPlane.z);
+    vec3 lo = textureLod(radiance, vec3(lightmapUv, float(vPage)), 0.0).rgb;
     uint h = pcgHash(randomSeed ^ pcgHash(uint(leafPixel.x) + 65536u * uint(leafPixel.y)) ^ pcgHash(vTriangle + 0x9E3779B9u));
     vec3 u = vec3(uniform01(h), uniform01(pcgHash(h)), uniform01(pcgHash(h + 1u)));
     uint flags;
@@ -36,6 +40,6 @@ void main() {
     else
         flags = dot(vFaceNormal, bundleDir) < 0.0 ? NODE_VISIBLE_FROM_BEHIND : NODE_VISIBLE_FROM_AHEAD;
     nodes[index].radiance = encodeRgbe(lo, u);
-    nodes[index].depth = (floatBitsToUint(vDepth) & ~NODE_FLAG_MASK) | flags;
+    nodes[index].depth = (floatBitsToUint(depth) & ~NODE_FLAG_MASK) | flags;
     nodes[index].next = imageAtomicExchange(heads, pixel, index);
 }

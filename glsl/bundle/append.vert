@@ -1,27 +1,76 @@
 #version 430
 // Bundle pass: orthographic projection of the scene along d into the tile.
+#include "shared/bundle_layout.h"
 #include "lib/bake_vertex.glsl"
 #include "lib/bundle_frame.glsl"
 
-out vec2 vLightmapUv;
-out float vDepth;
+uniform int viewportPixels;   // the viewport's side: a power of two >= leafPixels
+uniform float subpixelSteps;  // 2^GL_SUBPIXEL_BITS
+
+// The whole triangle, for the plane equations below (BakeVertex, 48 bytes).
+struct Vertex {
+    vec4 position;
+    vec4 normal;
+    vec2 uv0;
+    vec2 lightmapUv;
+};
+layout(std430, binding = BINDING_VERTICES) readonly buffer Vertices { Vertex vertices[]; };
+
+// Depth and light map uv as planes over the leaf's pixel grid: value =
+// dot(plane.xy, pixel centre) + plane.z. Every vertex of a triangle computes
+// the same planes from the same three vertices, and a fragment evaluates them
+// at its leaf pixel centre, so a node's depth and radiance do not depend on
+// which tile drew it (the rasterizer's own interpolation is set up relative
+// to the viewport, and differs in the last bits from tile to tile).
+flat out vec3 vDepthPlane;
+flat out vec3 vUPlane;
+flat out vec3 vVPlane;
 flat out uint vPage;
 flat out uint vFlags;
 flat out vec3 vFaceNormal;
 flat out uint vTriangle;
 
+vec3 plane(vec2 p0, vec2 p1, vec2 p2, float a0, float a1, float a2, float det) {
+    vec2 e1 = p1 - p0, e2 = p2 - p0;
+    float da1 = a1 - a0, da2 = a2 - a0;
+    vec2 grad = vec2(da1 * e2.y - da2 * e1.y, e1.x * da2 - e2.x * da1) / det;
+    return vec3(grad, a0 - dot(grad, p0));
+}
+
 void main() {
+    uint t = uint(gl_VertexID) / 3u;
     vec3 b = bundleFromWorld(inPosition.xyz);
-    // clip space of the leaf's grid: the viewport (-tileOffset, leafPixels) and
-    // a scissor to the tile select the tile, so every tile of a leaf rasterizes
-    // the same window coordinates (an integer shift) and shares each edge's coverage
-    vec2 ndc = gridFromRoot(rootFromBundle(b.xy)) / float(leafPixels) * 2.0 - 1.0;
+    // Clip space of the leaf's grid: the viewport (-tileOffset) and a scissor
+    // to the tile select the tile. Vertices are snapped to the rasterizer's
+    // subpixel grid, in a viewport of a power-of-two side: every step to
+    // window coordinates is then exact in float, so shifting the viewport by
+    // a tile's integer offset moves the snapped vertices by exactly that much,
+    // and each pixel's coverage is the same whichever tile draws it.
+    vec2 g = round(gridFromRoot(rootFromBundle(b.xy)) * subpixelSteps) / subpixelSteps;
+    vec2 ndc = g * (2.0 / float(viewportPixels)) - 1.0;
     gl_Position = vec4(ndc, 0.0, 1.0);  // no depth clipping: every fragment along the line counts
-    vLightmapUv = inLightmapUv;
-    vDepth = b.z;
-    uvec4 tri = triangles[gl_VertexID / 3];
+
+    vec3 c[3];
+    vec2 p[3];
+    for (int k = 0; k < 3; ++k) {
+        c[k] = bundleFromWorld(vertices[3u * t + uint(k)].position.xyz);
+        p[k] = gridFromRoot(rootFromBundle(c[k].xy));  // the true plane, not the snapped one: exact depths
+    }
+    float det = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[2].x - p[0].x) * (p[1].y - p[0].y);
+    if (det != 0.0) {
+        vDepthPlane = plane(p[0], p[1], p[2], c[0].z, c[1].z, c[2].z, det);
+        vec2 uv0 = vertices[3u * t].lightmapUv, uv1 = vertices[3u * t + 1u].lightmapUv, uv2 = vertices[3u * t + 2u].lightmapUv;
+        vUPlane = plane(p[0], p[1], p[2], uv0.x, uv1.x, uv2.x, det);
+        vVPlane = plane(p[0], p[1], p[2], uv0.y, uv1.y, uv2.y, det);
+    } else {
+        // no area on the grid: no fragment either (kept finite all the same)
+        vDepthPlane = vec3(0.0, 0.0, c[0].z);
+        vUPlane = vec3(0.0, 0.0, inLightmapUv.x);
+        vVPlane = vec3(0.0, 0.0, inLightmapUv.y);
+    }
+    uvec4 tri = triangles[t];
     vPage = tri.y;
     vFlags = tri.w;
     vFaceNormal = inNormal.xyz;
-    vTriangle = uint(gl_VertexID / 3);  // gl_PrimitiveID restarts with each draw of a multi-draw
+    vTriangle = t;  // gl_PrimitiveID restarts with each draw of a multi-draw
 }

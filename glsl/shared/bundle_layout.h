@@ -25,6 +25,7 @@ struct Node {
 // Bindings
 #define BINDING_NODES 0          // SSBO: Node nodes[]
 #define BINDING_NODE_COUNTER 0   // atomic counter: nodes appended
+#define BINDING_VERTICES 2       // SSBO: the bake vertices (BakeVertex, 48 bytes), read by the bundle pass
 #define BINDING_HEADS 0          // image unit: r32ui head pointers of the tile
 #define BINDING_ACCUM 1          // image unit: rg32ui accumulators (packed fp16 RGB + W), array of pages
 #define BINDING_SUN 2            // image unit: rgba32f direct sun L_lm, array of pages

@@ -37,6 +37,7 @@ struct FurnaceCase {
     double rho;
     int directions;
     double texelTolerance;  // relative, every covered texel and channel
+    BakeOptions::Tiling tiling = BakeOptions::Tiling::Adaptive;
 };
 
 void runFurnace(const FurnaceCase& fc) {
@@ -45,6 +46,7 @@ void runFurnace(const FurnaceCase& fc) {
     BakeOptions options;
     options.directions = fc.directions;
     options.seed = 1;
+    options.tiling = fc.tiling;
     SceneBake bake = makeBake(fc.file, assetLayout(64), options);
     ASSERT_TRUE(bake) << bake.error;
     const double seconds = bakeToEnd(*bake.baker);
@@ -73,6 +75,14 @@ TEST(FurnaceBake, Rho05Gives2Everywhere) { runFurnace({"assets/furnace/furnace.g
 
 TEST(FurnaceBake, Rho09Gives10Everywhere) { runFurnace({"assets/furnace/furnace_rho09.gltf", 0.9, 1024, 0.04}); }
 
+// The Hermes et al. baseline (--tiling uniform) gives the same answers.
+TEST(FurnaceBake, UniformTilingRho05Gives2Everywhere) {
+    runFurnace({"assets/furnace/furnace.gltf", 0.5, 256, 0.04, BakeOptions::Tiling::Uniform});
+}
+TEST(FurnaceBake, UniformTilingRho09Gives10Everywhere) {
+    runFurnace({"assets/furnace/furnace_rho09.gltf", 0.9, 1024, 0.04, BakeOptions::Tiling::Uniform});
+}
+
 // Uniform sky S over an upward single-sided plane (assets/sky_plane), albedo
 // 0.5: L_lm = S at every texel, whatever the iteration. Asset layout 64 x 64,
 // 64 directions. No sampling noise either (the whole upper hemisphere is sky),
@@ -83,9 +93,9 @@ TEST(FurnaceBake, Rho09Gives10Everywhere) { runFurnace({"assets/furnace/furnace_
 // (When the accumulators held fp16 sums, 256 directions already put the
 // worst texel 1.25% off: that noise grew with the direction count. They now
 // hold a running mean; see rounding_bake_test.cpp.)
-TEST(SkyPlaneBake, UniformSkyGivesSkyEverywhere) {
+void checkSkyPlane(BakeOptions::Tiling tiling) {
     BB_REQUIRE_GL();
-    SkyPlaneBake bake = bakeSkyPlane(64);
+    SkyPlaneBake bake = bakeSkyPlane(64, tiling);
     ASSERT_TRUE(bake.error.empty()) << bake.error;
     const glm::vec3 sky = bake.sky;
     const double seconds = bake.seconds;
@@ -106,6 +116,9 @@ TEST(SkyPlaneBake, UniformSkyGivesSkyEverywhere) {
                                         << describe(s, 64);
     }
 }
+
+TEST(SkyPlaneBake, UniformSkyGivesSkyEverywhere) { checkSkyPlane(BakeOptions::Tiling::Adaptive); }
+TEST(SkyPlaneBake, UniformTilingGivesSkyEverywhere) { checkSkyPlane(BakeOptions::Tiling::Uniform); }
 
 }  // namespace
 }  // namespace bb::test

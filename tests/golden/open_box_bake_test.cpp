@@ -63,7 +63,7 @@ double openingViewFactor(double x, double z) {
     return v;
 }
 
-TEST(OpenBoxBake, FloorProbesMatchSkyViewFactor) {
+void checkOpenBox(BakeOptions::Tiling tiling) {
     // the formula reproduces probes.json
     ASSERT_NEAR(openingViewFactor(0, 0), 0.239456470461, 1e-9);
     ASSERT_NEAR(openingViewFactor(0.25, 0.1), 0.220473362652, 1e-9);
@@ -81,6 +81,7 @@ TEST(OpenBoxBake, FloorProbesMatchSkyViewFactor) {
         options.directions = directions;
         options.seed = uint64_t(seed);
         options.sky = glm::vec3(1.0f);
+        options.tiling = tiling;
         SceneBake bake = makeBake("assets/open_box/open_box.gltf", assetLayout(res), options);
         ASSERT_TRUE(bake) << bake.error;
         seconds += bakeToEnd(*bake.baker);
@@ -146,6 +147,9 @@ TEST(OpenBoxBake, FloorProbesMatchSkyViewFactor) {
                 << "% (average of " << bakes << " bakes of " << directions << " directions)";
     }
 }
+
+TEST(OpenBoxBake, FloorProbesMatchSkyViewFactor) { checkOpenBox(BakeOptions::Tiling::Adaptive); }
+TEST(OpenBoxBake, UniformTilingFloorProbesMatchSkyViewFactor) { checkOpenBox(BakeOptions::Tiling::Uniform); }
 
 }  // namespace
 }  // namespace bb::test

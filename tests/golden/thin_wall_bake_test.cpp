@@ -31,7 +31,8 @@ namespace bb::test {
 namespace {
 
 // bundleResolution 0: the default (half a texel per bundle pixel).
-void checkSealedRoomStaysDark(int bundleResolution, int directions) {
+void checkSealedRoomStaysDark(int bundleResolution, int directions,
+                              BakeOptions::Tiling tiling = BakeOptions::Tiling::Adaptive) {
     BB_REQUIRE_GL();
     LayoutOptions layout;
     layout.mode = UvLayout::Pack;
@@ -41,6 +42,7 @@ void checkSealedRoomStaysDark(int bundleResolution, int directions) {
     options.directions = directions;
     options.seed = 1;
     options.bundleResolution = bundleResolution;
+    options.tiling = tiling;
     SceneBake bake = makeBake("assets/two_rooms/two_rooms.gltf", layout, options);
     ASSERT_TRUE(bake) << bake.error;
     ASSERT_NEAR(bake.layout.texelDensity, 50.0f, 1e-3f);
@@ -124,6 +126,7 @@ void checkSealedRoomStaysDark(int bundleResolution, int directions) {
 }
 
 TEST(ThinWallBake, SealedRoomBehindOneTexelWallStaysDark) { checkSealedRoomStaysDark(0, 128); }
+TEST(ThinWallBake, UniformTilingSealedRoomStaysDark) { checkSealedRoomStaysDark(0, 128, BakeOptions::Tiling::Uniform); }
 
 }  // namespace
 }  // namespace bb::test

@@ -82,9 +82,10 @@ struct SkyPlaneBake {
     std::string error;
 };
 
-inline SkyPlaneBake bakeSkyPlane(int directions) {
+inline SkyPlaneBake bakeSkyPlane(int directions, BakeOptions::Tiling tiling = BakeOptions::Tiling::Adaptive) {
     SkyPlaneBake out;
     BakeOptions options;
+    options.tiling = tiling;
     options.directions = directions;
     options.seed = 1;
     options.sky = out.sky;

@@ -31,6 +31,8 @@ gl::Context* sharedContext(std::string* why) {
     return context.get();
 }
 
-std::string sourcePath(const std::string& relative) { return std::string(BUNDLEBAKE_SOURCE_DIR) + "/" + relative; }
+std::string sourcePath(const std::string& relative) {
+    return !relative.empty() && relative[0] == '/' ? relative : std::string(BUNDLEBAKE_SOURCE_DIR) + "/" + relative;
+}
 
 }  // namespace bb::test

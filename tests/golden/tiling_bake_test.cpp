@@ -1,0 +1,165 @@
+// Adaptive tiling on generated cities (scripts/generate_city.py): the memory
+// budget and culling change how a direction is cut and drawn, never the
+// light maps (bitwise); the node prediction holds on three scene sizes.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <string>
+
+#include "support/bake_helper.h"
+
+namespace bb::test {
+namespace {
+
+// Generates a tiny city (seeded) into the test's temp dir; returns its path relative to nothing (absolute).
+std::string generateCity(const std::string& name, const std::string& flags) {
+    const std::string dir = ::testing::TempDir() + "/tiling_" + std::to_string(::getpid());
+    std::filesystem::create_directories(dir);
+    const std::string path = dir + "/" + name + ".gltf";
+    const std::string cmd = "python3 " + sourcePath("scripts/generate_city.py") + " --preset tiny " + flags + " -o " +
+                            path + " > /dev/null";
+    const int status = std::system(cmd.c_str());
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) return "";
+    return path;
+}
+
+LayoutOptions cityLayout() {
+    LayoutOptions l;
+    l.mode = UvLayout::Pack;
+    l.resolution = 512;
+    return l;
+}
+
+BakeOptions cityOptions() {
+    BakeOptions o;
+    o.directions = 8;
+    o.seed = 3;
+    o.sky = glm::vec3(1.0f);
+    return o;
+}
+
+struct Baked {
+    std::vector<std::vector<glm::vec4>> accumulators;
+    BakeStats stats;
+    std::string error;
+};
+
+Baked bakeCity(const std::string& path, const BakeOptions& options) {
+    Baked out;
+    SceneBake bake = makeBake(path, cityLayout(), options);
+    if (!bake) {
+        out.error = bake.error;
+        return out;
+    }
+    bakeToEnd(*bake.baker);
+    out.accumulators = bake.baker->readAccumulators();
+    out.stats = bake.baker->stats();
+    return out;
+}
+
+size_t differingTexels(const Baked& a, const Baked& b) {
+    size_t n = 0;
+    for (size_t p = 0; p < a.accumulators.size(); ++p)
+        for (size_t i = 0; i < a.accumulators[p].size(); ++i)
+            n += std::memcmp(&a.accumulators[p][i], &b.accumulators[p][i], sizeof(glm::vec4)) != 0;
+    return n;
+}
+
+// A tiny budget (head image 64^2, 3000 nodes) cuts every direction into many
+// tiles, and with prediction off only overflow splits them; the leaves (and
+// so the pixels) do not depend on the budget, and neither does any random
+// number, so the accumulators are the same bits.
+TEST(TilingBake, TinyBudgetGivesTheSameBits) {
+    BB_REQUIRE_GL();
+    const std::string city = generateCity("budget", "--seed 5");
+    ASSERT_FALSE(city.empty()) << "scripts/generate_city.py failed";
+    const Baked roomy = bakeCity(city, cityOptions());
+    ASSERT_TRUE(roomy.error.empty()) << roomy.error;
+    BakeOptions tightOptions = cityOptions();
+    tightOptions.memoryBudget = 64 * 64 * 4 + 3000 * 12;
+    const Baked tight = bakeCity(city, tightOptions);
+    ASSERT_TRUE(tight.error.empty()) << tight.error;
+    tightOptions.predictTiles = false;
+    const Baked splitOnly = bakeCity(city, tightOptions);
+    ASSERT_TRUE(splitOnly.error.empty()) << splitOnly.error;
+
+    std::printf("[tiling] tiles drawn %lld (roomy), %lld (tight, %lld overflows), %lld (overflow splits only, %lld "
+                "overflows); fragments %lld / %lld / %lld\n",
+                (long long)roomy.stats.tilesDrawn, (long long)tight.stats.tilesDrawn, (long long)tight.stats.overflows,
+                (long long)splitOnly.stats.tilesDrawn, (long long)splitOnly.stats.overflows,
+                (long long)roomy.stats.fragments, (long long)tight.stats.fragments,
+                (long long)splitOnly.stats.fragments);
+    EXPECT_GT(tight.stats.tilesDrawn, 4 * roomy.stats.tilesDrawn);
+    EXPECT_GT(splitOnly.stats.overflows, 0) << "the tight buffer never overflowed: the test no longer tests overflow";
+    EXPECT_LE(tight.stats.peakNodesPerTile, 3000);
+    // every fragment drawn exactly once, however the directions were cut
+    EXPECT_EQ(tight.stats.fragments, roomy.stats.fragments);
+    EXPECT_EQ(splitOnly.stats.fragments, roomy.stats.fragments);
+    EXPECT_EQ(differingTexels(roomy, tight), 0u);
+    EXPECT_EQ(differingTexels(roomy, splitOnly), 0u);
+    EXPECT_EQ(differingTexels(tight, splitOnly), 0u);
+}
+
+// Culling draws a fraction of the clusters per tile and changes no bit.
+TEST(TilingBake, CullingChangesNothing) {
+    BB_REQUIRE_GL();
+    const std::string city = generateCity("culling", "--seed 6");
+    ASSERT_FALSE(city.empty()) << "scripts/generate_city.py failed";
+    BakeOptions o = cityOptions();
+    o.memoryBudget = 1 << 20;  // several tiles per direction, so there is something to cull
+    const Baked on = bakeCity(city, o);
+    ASSERT_TRUE(on.error.empty()) << on.error;
+    o.cull = false;
+    const Baked off = bakeCity(city, o);
+    ASSERT_TRUE(off.error.empty()) << off.error;
+    std::printf("[tiling] culling: %lld tiles; bundle pass drew %lld triangles with culling, %lld without\n",
+                (long long)on.stats.tilesDrawn, (long long)on.stats.bundleTrianglesDrawn,
+                (long long)off.stats.bundleTrianglesDrawn);
+    ASSERT_EQ(on.stats.tilesDrawn, off.stats.tilesDrawn);
+    EXPECT_GT(on.stats.tilesDrawn, on.stats.directionsDone);
+    EXPECT_LT(on.stats.bundleTrianglesDrawn, off.stats.bundleTrianglesDrawn / 2);
+    EXPECT_EQ(on.stats.fragments, off.stats.fragments);
+    EXPECT_EQ(differingTexels(on, off), 0u);
+}
+
+// The projected-area prediction per tile on three generated sizes, cut into
+// several tiles by a small budget: median within 20 %, p10 >= 0.5, p90 <= 2,
+// under 1 % of tiles overflowing.
+TEST(TilingBake, PredictionHoldsOnThreeSizes) {
+    BB_REQUIRE_GL();
+    struct Size {
+        const char* name;
+        const char* flags;
+    } sizes[] = {{"s1", "--seed 7 --size-m 120 --buildings 40"},
+                 {"s2", "--seed 8"},
+                 {"s3", "--seed 9 --size-m 320 --buildings 300 --terrain-quads 12"}};
+    for (const Size& s : sizes) {
+        const std::string city = generateCity(s.name, s.flags);
+        ASSERT_FALSE(city.empty()) << "scripts/generate_city.py failed for " << s.flags;
+        BakeOptions o = cityOptions();
+        o.memoryBudget = 1 << 20;
+        const Baked b = bakeCity(city, o);
+        ASSERT_TRUE(b.error.empty()) << b.error;
+        std::vector<double> r = b.stats.predictedOverActual;
+        ASSERT_GT(r.size(), 8u);
+        std::sort(r.begin(), r.end());
+        auto pct = [&](double q) { return r[size_t(q * (r.size() - 1))]; };
+        std::printf("[tiling] %s (%s): %lld triangles, %zu tiles, predicted/actual p10 %.3f median %.3f p90 %.3f, "
+                    "%lld overflows\n",
+                    s.name, s.flags, (long long)b.stats.triangles, r.size(), pct(0.1), pct(0.5), pct(0.9),
+                    (long long)b.stats.overflows);
+        EXPECT_NEAR(pct(0.5), 1.0, 0.2) << s.name;
+        EXPECT_GE(pct(0.1), 0.5) << s.name;
+        EXPECT_LE(pct(0.9), 2.0) << s.name;
+        EXPECT_LT(double(b.stats.overflows), 0.01 * double(b.stats.tilesDrawn)) << s.name;
+    }
+}
+
+}  // namespace
+}  // namespace bb::test
