@@ -1,6 +1,6 @@
 // bundlebake-viewer: watch the light maps converge while the bake runs in the
 // same GL context. Each frame bakes directions for up to a frame budget
-// (Baker::step, default 30 ms: at least one direction per frame), resolves the
+// (Baker::stepTiles, default 30 ms: at least one tile per frame), resolves the
 // light maps on the GPU (Baker::resolveLightmaps) and draws the scene with
 // them (engine/render/scene_renderer.h), then a Dear ImGui panel.
 //
@@ -194,7 +194,7 @@ private:
 
     bool paused_ = false;
     double frameBudgetMs_ = 30.0;
-    double directionSeconds_ = 0.0;     // running mean of one direction's bake time
+    double tileSeconds_ = 0.0;     // running mean of one tile's bake time (bundle + update)
     std::deque<std::pair<double, int>> rateWindow_;  // (time, directions done) over the last seconds
     double directionsPerSecond_ = 0.0;
     double bakeSeconds_ = 0.0;           // wall time spent in Baker::step
@@ -226,7 +226,7 @@ Status Viewer::startBake() {
     renderer_->setBundleGrid(baker_->bundleGrid());
     rateWindow_.clear();
     directionsPerSecond_ = 0;
-    directionSeconds_ = 0;
+    tileSeconds_ = 0;
     bakeSeconds_ = 0;
     bakeDoneAt_ = -1;
     bakeStart_ = Clock::now();
@@ -239,19 +239,20 @@ Status Viewer::startBake() {
 
 void Viewer::bakeStep() {
     if (!baker_ || paused_ || baker_->progress().done()) return;
-    // budget minus one direction's expected time, so the last one ends near the budget
+    // tile by tile: budget minus one tile's expected time, so the last one ends near the budget
+    // (a direction of a large scene takes seconds; one of its tiles a few milliseconds)
     const double budget = frameBudgetMs_ * 1e-3;
-    const double stepBudget = std::max(0.0, budget - directionSeconds_);
-    const int before = baker_->progress().directionsDone;
+    const double stepBudget = std::max(0.0, budget - tileSeconds_);
+    const int64_t before = baker_->stats().tilesDrawn;
     auto t0 = Clock::now();
-    BakeProgress p = baker_->step(stepBudget);
+    BakeProgress p = baker_->stepTiles(stepBudget);
     baker_->resolveLightmaps();
     const double spent = secondsSince(t0);
     bakeSeconds_ += spent;
-    const int stepped = p.directionsDone - before;
+    const int64_t stepped = baker_->stats().tilesDrawn - before;
     if (stepped > 0) {
-        const double perDirection = spent / stepped;
-        directionSeconds_ = directionSeconds_ > 0 ? 0.8 * directionSeconds_ + 0.2 * perDirection : perDirection;
+        const double perTile = spent / double(stepped);
+        tileSeconds_ = tileSeconds_ > 0 ? 0.8 * tileSeconds_ + 0.2 * perTile : perTile;
     }
     renderer_->setBundleGrid(baker_->bundleGrid());
     if (p.done()) {
@@ -400,7 +401,7 @@ void Viewer::drawPanel() {
         else
             ImGui::Text("%.2f directions/s, ETA %s%s", directionsPerSecond_, paused_ ? "- (paused)" : duration(eta).c_str(),
                         "");
-        ImGui::Text("%.1f ms per direction, %.1f s baking", directionSeconds_ * 1e3, bakeSeconds_);
+        ImGui::Text("%.1f ms per direction, %.1f s baking", tileSeconds_ * 1e3, bakeSeconds_);
         if (ImGui::Button(paused_ ? "Resume" : "Pause")) paused_ = !paused_;
         ImGui::SameLine();
         if (ImGui::Button("Restart")) {
@@ -436,7 +437,7 @@ void Viewer::drawPanel() {
         const int perSide = (g.gridSize + g.tileStep - 1) / std::max(g.tileStep, 1);
         ImGui::Text("direction %d: (%.3f, %.3f, %.3f)", std::max(progress.directionsDone - 1, 0), g.dir.x, g.dir.y, g.dir.z);
         ImGui::Text("bundle %d^2 px, pixel %.4g units", g.gridSize, g.pixelSize);
-        ImGui::Text("tiles drawn %d (grid %dx%d of %d px)", g.tiles, perSide, perSide, g.tileStep);
+        ImGui::Text("tiles drawn %d (finest leaf %d px, %d across the root)", g.tiles, g.tileStep, perSide);
         ImGui::Text("overflows redrawn %lld, tiles in all %lld", (long long)stats.overflows, (long long)stats.tilesDrawn);
         ImGui::Checkbox("show tile grid (T)", &settings_.tileOverlay);
         ImGui::TextDisabled("strong lines: tile edges; faint: every 64 bundle pixels");
@@ -512,7 +513,7 @@ void Viewer::drawPanel() {
 
 void Viewer::logFrameTimes() const {
     char budget[96];
-    std::snprintf(budget, sizeof budget, " (bake budget %.0f ms per frame, at least one direction)", frameBudgetMs_);
+    std::snprintf(budget, sizeof budget, " (bake budget %.0f ms per frame, at least one tile)", frameBudgetMs_);
     logInfo("frame time while baking: " + bakingFrames_.describe() + budget);
     logInfo("  of which bake (step + resolve): " + bakeParts_.describe() + "; draw (scene + panel + swap): " +
             drawParts_.describe());
@@ -673,7 +674,7 @@ int runViewer(int argc, char** argv) {
         ->capture_default_str();
     app.add_option("--width", a.width, "Window width")->check(CLI::Range(64, 16384))->capture_default_str();
     app.add_option("--height", a.height, "Window height")->check(CLI::Range(64, 16384))->capture_default_str();
-    app.add_option("--frame-budget", a.frameBudgetMs, "Bake milliseconds per frame (at least one direction per frame)")
+    app.add_option("--frame-budget", a.frameBudgetMs, "Bake milliseconds per frame (at least one bundle tile per frame)")
         ->check(CLI::Range(0.0, 10000.0))
         ->capture_default_str();
     app.add_option("--camera", a.camera, "Start at this glTF camera (-1: frame the scene along camera 0's view)")

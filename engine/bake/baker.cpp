@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "bake/bundle_tracer.h"
 #include "bake/directions.h"
 #include "core/check.h"
 #include "core/log.h"
@@ -24,18 +25,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-// Where one tile lies: the direction's frame, its leaf and its window of
-// the leaf's grid (glsl/lib/bundle_frame.glsl reads these as uniforms).
-struct TileFrame {
-    glm::vec3 d{0.0f}, u{0.0f}, v{0.0f};
-    glm::vec2 rootOrigin{0.0f};
-    float rootSize = 1.0f;
-    BundleLeaf leaf;
-    TileWindow window;
-    float pixelSize = 1.0f;
-    uint32_t leafSeed = 0;  // per direction and leaf: the same for every budget
-};
 
 
 // Per texel of every page, the covered texel whose value it shows: itself if
@@ -92,24 +81,23 @@ struct Baker::Impl {
     std::vector<double> projectedArea;  // per triangle world area
     std::vector<Cluster> clusters;      // the mesh in culling units (engine/tiler)
     TilerOptions tilerOptions;
-    std::vector<int32_t> drawFirst, drawCount;  // scratch: multi-draw ranges of a tile
-    BundleFrame lastFrame;                      // the latest direction's tiling (viewer overlay)
-    std::vector<BundleLeaf> lastLeaves;
 
     // GL objects
-    gl::Buffer vertexBuffer, triangleBuffer, metaIndexBuffer, nodeBuffer, counterBuffer;
+    gl::Buffer vertexBuffer, triangleBuffer, metaIndexBuffer;
     gl::VertexArray vao;
-    gl::Texture albedoMap, emissionMap, accum, sunMap, radiance, resolved, heads, envTexture, dilationSource;
-    gl::Framebuffer bundleFbo, pageFbo, metaFbo;
-    gl::Program appendProgram, updateProgram, sunProgram, resolveProgram, rescaleProgram, metaProgram, distanceProgram,
+    gl::Texture albedoMap, emissionMap, accum, sunMap, radiance, resolved, envTexture, dilationSource;
+    gl::Framebuffer pageFbo, metaFbo;
+    gl::Program updateProgram, sunProgram, resolveProgram, rescaleProgram, metaProgram, distanceProgram,
         emitterProgram;
     gl::Texture emitterMap;
     std::vector<glm::vec3> textureMeans;  // mean linear RGB of each scene texture (explicit emitters)
     std::vector<gl::Texture> materialTextures;
     int64_t nodeCapacity = 0;     // nodes the budget allows in one tile
-    int64_t nodeAllocated = 0;    // nodes the buffer holds now (grown from the predictions)
-    int headSide = 0;             // the head image's side now (grown to the largest tile)
     int subpixelBits = 8;         // GL_SUBPIXEL_BITS
+    std::unique_ptr<BundleTracer> tracer;
+    // the direction in progress (Baker::stepTiles can stop between its tiles)
+    bool directionActive = false;
+    BundleTracer::UpdateFn directionUpdate;
 
     Status init(const Scene& scene);
     Status buildPrograms();
@@ -118,21 +106,15 @@ struct Baker::Impl {
     void bakeSun();
     bool useExplicitEmitters() const;
     void bakeEmitters();
-    void bakeDirection(int index);
-    // Tiles the bundle of direction d (engine/tiler), draws each tile's
-    // culled clusters into the linked lists (growing the node buffer, or
-    // splitting the tile, on overflow) and, for each tile that fits, calls
-    // `update(frame, nodeCount)`, which binds its program and sets its
-    // uniforms; the tile's receiving clusters are then drawn in light map
-    // space with that program. oneTile: the uniform grid as one tile, no
-    // culling (captureBundle).
+    // The root square of direction d: the uniform grid, or the adaptive root.
+    BundleFrame bundleFrame(const glm::vec3& d, glm::vec2 jitter, bool uniformGrid) const;
+    // All tiles of direction d (bundle_tracer.h), each followed by `update`.
     template <class UpdateFn>
-    void traceBundle(const glm::vec3& d, glm::vec2 jitter, uint32_t seed, UpdateFn update, bool recordStats,
-                     bool oneTile = false);
-    void setFrameUniforms(GLuint program, const TileFrame& f);
-    void ensureNodes(int64_t nodes);
-    void ensureHeads(int side);
-    void drawClusters(const std::vector<uint32_t>& ids, bool receiversOnly);
+    void traceBundle(const glm::vec3& d, glm::vec2 jitter, uint32_t seed, UpdateFn update, bool recordStats);
+    // Direction k: the history ramp, then its tiles one by one, then the radiance refresh.
+    void beginDirection(int k);
+    void stepTile();
+    void finishDirection(int k);
     void resolveInto(bool radianceOut, gl::Texture& target);
     void dispatchPages(GLuint program);
 };
@@ -184,7 +166,6 @@ Status Baker::Impl::buildPrograms() {
         std::vector<std::string> files;
         std::string defines;
     } specs[] = {
-        {&appendProgram, {"bundle/append.vert", "bundle/append.frag"}, rounding},
         {&updateProgram, {"lightmap/update.vert", "lightmap/update.frag"}, rounding},
         {&sunProgram, {"lightmap/update.vert", "lightmap/update.frag"}, "#define SUN_PASS 1\n"},
         {&resolveProgram, {"lightmap/resolve.comp"}, ""},
@@ -414,16 +395,19 @@ Status Baker::Impl::init(const Scene& scene) {
     glClearTexImage(sunMap.id(), 0, GL_RGBA, GL_FLOAT, zeroF);
     glClearTexImage(emitterMap.id(), 0, GL_RGBA, GL_FLOAT, zeroF);
     glClearTexImage(radiance.id(), 0, GL_RGBA, GL_FLOAT, zeroF);
-    // node buffer and head image start small and grow to what the tiles predict
-    counterBuffer = gl::Buffer::create("bundle node counter", 4, nullptr, GL_DYNAMIC_STORAGE_BIT);
-    ensureNodes(options.predictTiles ? std::min<int64_t>(nodeCapacity, 1 << 16) : nodeCapacity);
-    ensureHeads(64);
-    bundleFbo = gl::Framebuffer::create("bundle framebuffer (no attachments)");
-    glNamedFramebufferParameteri(bundleFbo.id(), GL_FRAMEBUFFER_DEFAULT_WIDTH, maxTileSize);
-    glNamedFramebufferParameteri(bundleFbo.id(), GL_FRAMEBUFFER_DEFAULT_HEIGHT, maxTileSize);
     pageFbo = gl::Framebuffer::create("light map page framebuffer (no attachments)");
     glNamedFramebufferParameteri(pageFbo.id(), GL_FRAMEBUFFER_DEFAULT_WIDTH, res);
     glNamedFramebufferParameteri(pageFbo.id(), GL_FRAMEBUFFER_DEFAULT_HEIGHT, res);
+    {
+        // the bundle pass: its buffers start small and grow to what the tiles predict
+        const BundleScene scene{&mesh, &clusters, vao.id(), vertexBuffer.id(), triangleBuffer.id(), radiance.id(),
+                                pageFbo.id(), res};
+        const BundleLimits limits{nodeCapacity, maxTileSize, subpixelBits, options.predictTiles};
+        auto t = BundleTracer::create(scene, limits,
+                                      options.rounding == Rounding::Nearest ? "#define ROUNDING_NEAREST 1\n" : "", &stats);
+        if (!t) return t.status();
+        tracer = std::move(t.value());
+    }
 
     if (options.environment) {
         const auto& env = *options.environment;
@@ -470,194 +454,27 @@ Status Baker::Impl::init(const Scene& scene) {
     return Status::ok();
 }
 
-void Baker::Impl::setFrameUniforms(GLuint program, const TileFrame& f) {
-    glUniform3fv(glGetUniformLocation(program, "bundleDir"), 1, &f.d.x);
-    glUniform3fv(glGetUniformLocation(program, "bundleU"), 1, &f.u.x);
-    glUniform3fv(glGetUniformLocation(program, "bundleV"), 1, &f.v.x);
-    glUniform2fv(glGetUniformLocation(program, "rootOrigin"), 1, &f.rootOrigin.x);
-    glUniform1f(glGetUniformLocation(program, "rootSize"), f.rootSize);
-    glUniform2f(glGetUniformLocation(program, "leafMin"), float(f.leaf.min.x), float(f.leaf.min.y));
-    glUniform1f(glGetUniformLocation(program, "leafExtent"), float(f.leaf.extent));
-    glUniform1i(glGetUniformLocation(program, "leafPixels"), f.leaf.pixels);
-    glUniform1f(glGetUniformLocation(program, "pixelSize"), f.pixelSize);
-    glUniform2i(glGetUniformLocation(program, "tileOffset"), f.window.x, f.window.y);
-    glUniform2i(glGetUniformLocation(program, "tileSize"), f.window.width, f.window.height);
-}
-
-void Baker::Impl::ensureNodes(int64_t nodes) {
-    nodes = std::min(nodes, nodeCapacity);
-    if (nodes <= nodeAllocated) return;
-    // grow by at least half, so a run of growing tiles reallocates a few times only
-    nodes = std::min(std::max(nodes, nodeAllocated + nodeAllocated / 2), nodeCapacity);
-    nodeBuffer = gl::Buffer();  // free first: the budget is for one buffer
-    nodeBuffer = gl::Buffer::create("bundle nodes", nodes * int64_t(sizeof(shared::Node)), nullptr, 0);
-    nodeAllocated = nodes;
-    stats.nodeBufferBytes = std::max<int64_t>(stats.nodeBufferBytes, nodeBuffer.bytes());
-}
-
-void Baker::Impl::ensureHeads(int side) {
-    if (side <= headSide) return;
-    int s = 64;
-    while (s < side) s *= 2;
-    s = std::min(s, maxTileSize);
-    heads = gl::Texture();
-    heads = gl::Texture::create2D("bundle head pointers", GL_R32UI, s, s);
-    headSide = s;
-    stats.headImageBytes = std::max<int64_t>(stats.headImageBytes, heads.bytes());
-}
-
-void Baker::Impl::drawClusters(const std::vector<uint32_t>& ids, bool receiversOnly) {
-    if (receiversOnly) {
-        std::vector<uint32_t> receivers;
-        for (uint32_t i : ids)
-            if (clusters[i].maxImportance > 0.0f) receivers.push_back(i);
-        clusterRanges(clusters, receivers, drawFirst, drawCount);
-    } else {
-        clusterRanges(clusters, ids, drawFirst, drawCount);
-    }
-    if (!drawFirst.empty()) glMultiDrawArrays(GL_TRIANGLES, drawFirst.data(), drawCount.data(), GLsizei(drawFirst.size()));
-    int64_t triangles = 0;
-    for (int32_t c : drawCount) triangles += c / 3;
-    (receiversOnly ? stats.updateTrianglesDrawn : stats.bundleTrianglesDrawn) += triangles;
-}
-
-template <class UpdateFn>
-void Baker::Impl::traceBundle(const glm::vec3& d, glm::vec2 jitter, uint32_t seed, UpdateFn update, bool recordStats,
-                              bool oneTile) {
-    auto tt = Clock::now();
-    // the root square: the uniform grid, or (adaptive) the bounding sphere's square with a pixel of margin for the jitter
+BundleFrame Baker::Impl::bundleFrame(const glm::vec3& d, glm::vec2 jitter, bool uniformGrid) const {
     BundleFrame frame;
     frame.dir = d;
     orthonormalBasis(d, frame.u, frame.v);
-    TilerOptions to = tilerOptions;
     const glm::dvec2 centre(glm::dot(glm::dvec3(sphereCenter), glm::dvec3(frame.u)),
                             glm::dot(glm::dvec3(sphereCenter), glm::dvec3(frame.v)));
-    if (oneTile || to.uniform) {
-        to.uniform = true;
-        to.fixedPixelSize = pixelSize;
+    if (uniformGrid) {
+        // the uniform grid: gridSize pixels across the bounding sphere
         frame.size = double(gridSize) * pixelSize;
         frame.origin = centre - glm::dvec2(sphereRadius) + glm::dvec2(jitter) * double(pixelSize);
     } else {
+        // the bounding sphere's square, with a (uniform) pixel of margin for the sun's jitter
         frame.size = 2.0 * (double(sphereRadius) + pixelSize);
         frame.origin = centre - glm::dvec2(sphereRadius + pixelSize) + glm::dvec2(jitter) * double(pixelSize);
     }
-    if (oneTile) {
-        to.cull = false;
-        to.nodeCapacity = 1e300;
-        to.maxTilePixels = gridSize;
-    }
-    const std::vector<ClusterView> views = projectClusters(mesh, clusters, frame);
-    const DirectionTiling tiling = tileBundle(clusters, views, frame.size, to);
-    if (recordStats) {
-        stats.secondsTiling += secondsSince(tt);
-        stats.leavesPerDirection.push_back(int(tiling.leaves.size()));
-    }
-    if (recordStats) {
-        lastFrame = frame;
-        lastLeaves = tiling.leaves;
-    }
+    return frame;
+}
 
-    std::vector<Tile> work(tiling.tiles.rbegin(), tiling.tiles.rend());
-    int tiles = 0;
-    const uint32_t endOfList = END_OF_LIST;
-    while (!work.empty()) {
-        Tile tile = std::move(work.back());
-        work.pop_back();
-        TileFrame f;
-        f.d = d;
-        f.u = frame.u;
-        f.v = frame.v;
-        f.rootOrigin = glm::vec2(frame.origin);
-        f.rootSize = float(frame.size);
-        f.leaf = tiling.leaves[size_t(tile.leaf)];
-        f.window = tile.window;
-        f.pixelSize = float(tiling.pixelSize(tile.leaf));
-        f.leafSeed = pcgHash(seed ^ pcgHash(uint32_t(tile.leaf) * 7919u + 17u));
-        // buffers sized from the prediction (a quarter of margin), within the budget
-        if (options.predictTiles) ensureNodes(int64_t(std::ceil(1.25 * tile.predictedNodes)) + 1024);
-        ensureHeads(std::max(tile.window.width, tile.window.height));
-
-        auto tb = Clock::now();
-        {
-            gl::DebugGroup group("bundle pass");
-            glClearTexSubImage(heads.id(), 0, 0, 0, 0, tile.window.width, tile.window.height, 1, GL_RED_INTEGER,
-                               GL_UNSIGNED_INT, &endOfList);
-            const uint32_t zero = 0;
-            glNamedBufferSubData(counterBuffer.id(), 0, 4, &zero);
-            glUseProgram(appendProgram.id());
-            setFrameUniforms(appendProgram.id(), f);
-            glUniform1ui(appendProgram.uniform("nodeCapacity"), uint32_t(nodeAllocated));
-            glUniform1ui(appendProgram.uniform("randomSeed"), f.leafSeed);
-            glBindFramebuffer(GL_FRAMEBUFFER, bundleFbo.id());
-            // the leaf's grid in a power-of-two viewport (glsl/bundle/append.vert) shifted so the
-            // tile lands at (0, 0); the scissor keeps the rest out
-            int viewportPixels = 1;
-            while (viewportPixels < f.leaf.pixels) viewportPixels *= 2;
-            glUniform1i(appendProgram.uniform("viewportPixels"), viewportPixels);
-            glUniform1f(appendProgram.uniform("subpixelSteps"), float(1 << subpixelBits));
-            glViewport(-tile.window.x, -tile.window.y, viewportPixels, viewportPixels);
-            glEnable(GL_SCISSOR_TEST);
-            glScissor(0, 0, tile.window.width, tile.window.height);
-            glBindVertexArray(vao.id());
-            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, triangleBuffer.id());
-            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_NODES, nodeBuffer.id());
-            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_VERTICES, vertexBuffer.id());
-            glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, BINDING_NODE_COUNTER, counterBuffer.id());
-            glBindImageTexture(BINDING_HEADS, heads.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
-            glBindTextureUnit(BINDING_RADIANCE, radiance.id());
-            drawClusters(tile.clusters, false);
-            glDisable(GL_SCISSOR_TEST);
-            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
-                            GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-        }
-        uint32_t count = 0;
-        glGetNamedBufferSubData(counterBuffer.id(), 0, 4, &count);
-        if (recordStats) stats.secondsBundle += secondsSince(tb);
-        ++tiles;
-        ++stats.tilesDrawn;
-        if (int64_t(count) > nodeAllocated) {
-            // overflow: nothing is used from this draw. Redraw into a buffer of
-            // the measured size if the budget holds it, else in four quarters.
-            ++stats.overflows;
-            if (int64_t(count) <= nodeCapacity && options.predictTiles) {
-                ensureNodes(int64_t(count));
-                work.push_back(std::move(tile));
-                continue;
-            }
-            CHECK(tile.window.width > 1 || tile.window.height > 1);
-            auto quarters = splitWindow(tile.window);
-            for (auto it = quarters.rbegin(); it != quarters.rend(); ++it)
-                work.push_back(makeTile(tiling, tile.leaf, *it, clusters, views, tile.clusters, to.cull));
-            continue;
-        }
-        if (recordStats) {
-            stats.fragments += count;
-            stats.peakNodesPerTile = std::max<int64_t>(stats.peakNodesPerTile, count);
-            if (count > 0) stats.predictedOverActual.push_back(tile.predictedNodes / count);
-            stats.tilePixelSizes.push_back(f.pixelSize);
-        }
-        if (count == 0) continue;
-        auto tu = Clock::now();
-        {
-            gl::DebugGroup group("update pass");
-            glBindFramebuffer(GL_FRAMEBUFFER, pageFbo.id());
-            glViewport(0, 0, layout.resolution, layout.resolution);
-            GLuint program = update(f, count);
-            if (!program) continue;
-            setFrameUniforms(program, f);
-            glUniform1ui(glGetUniformLocation(program, "nodeCount"), count);
-            glBindImageTexture(BINDING_HEADS, heads.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
-            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_NODES, nodeBuffer.id());
-            drawClusters(tile.clusters, true);
-            glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
-        }
-        if (recordStats) {
-            glFinish();
-            stats.secondsUpdate += secondsSince(tu);
-        }
-    }
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    if (recordStats) stats.tilesPerDirection.push_back(tiles);
+template <class UpdateFn>
+void Baker::Impl::traceBundle(const glm::vec3& d, glm::vec2 jitter, uint32_t seed, UpdateFn update, bool recordStats) {
+    tracer->run(bundleFrame(d, jitter, tilerOptions.uniform), tilerOptions, seed, recordStats, update);
 }
 
 void Baker::Impl::bakeSun() {
@@ -806,7 +623,7 @@ void Baker::Impl::bakeEmitters() {
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
-void Baker::Impl::bakeDirection(int k) {
+void Baker::Impl::beginDirection(int k) {
     const glm::vec3 d = directions[size_t(k)];
     // history ramp: weight min(k+1, K)^power relative to the stored scale
     double rampEnd = std::max(1, options.directions / 2);
@@ -822,22 +639,33 @@ void Baker::Impl::bakeDirection(int k) {
         accumScale = weight;
         sampleWeight = 1.0;
     }
-    uint32_t seed = pcgHash(uint32_t(options.seed) * 0x9E3779B1u ^ pcgHash(uint32_t(k)));
-    bool useEnv = bool(envTexture);
-    traceBundle(d, glm::vec2(0.0f), seed,
-        [&](const TileFrame&, uint32_t) -> GLuint {
-            glUseProgram(updateProgram.id());
-            glUniform1f(updateProgram.uniform("sampleWeight"), float(sampleWeight));
-            // per direction, not per tile: each texel is updated once per direction, and tiles change with the budget
-            glUniform1ui(updateProgram.uniform("randomSeed"), seed);
-            glUniform3fv(updateProgram.uniform("sky"), 1, &options.sky.x);
-            glUniform1i(updateProgram.uniform("useEnv"), useEnv);
-            glUniform1f(updateProgram.uniform("depthBias"), depthBias);
-            if (useEnv) glBindTextureUnit(BINDING_ENV, envTexture.id());
-            glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
-            return updateProgram.id();
-        },
-        true);
+    const uint32_t seed = pcgHash(uint32_t(options.seed) * 0x9E3779B1u ^ pcgHash(uint32_t(k)));
+    directionUpdate = [this, sampleWeight, seed](const TileFrame&, uint32_t) -> GLuint {
+        const bool useEnv = bool(envTexture);
+        glUseProgram(updateProgram.id());
+        glUniform1f(updateProgram.uniform("sampleWeight"), float(sampleWeight));
+        // per direction, not per tile: each texel is updated once per direction, and tiles change with the budget
+        glUniform1ui(updateProgram.uniform("randomSeed"), seed);
+        glUniform3fv(updateProgram.uniform("sky"), 1, &options.sky.x);
+        glUniform1i(updateProgram.uniform("useEnv"), useEnv);
+        glUniform1f(updateProgram.uniform("depthBias"), depthBias);
+        if (useEnv) glBindTextureUnit(BINDING_ENV, envTexture.id());
+        glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
+        return updateProgram.id();
+    };
+    tracer->begin(bundleFrame(d, glm::vec2(0.0f), tilerOptions.uniform), tilerOptions, seed, true);
+    directionActive = true;
+}
+
+void Baker::Impl::stepTile() {
+    const int k = stats.directionsDone;
+    if (!directionActive) beginDirection(k);
+    if (!tracer->done()) tracer->next(directionUpdate);
+    if (tracer->done()) finishDirection(k);
+}
+
+void Baker::Impl::finishDirection(int k) {
+    directionActive = false;
     stats.updatedTexels += stats.coveredTexels;
     // Refresh the outgoing radiance the next bundles read. Every direction at
     // first, when each one adds a bounce; later every k/32 directions (at most
@@ -884,14 +712,27 @@ Expected<std::unique_ptr<Baker>> Baker::create(const Scene& scene, const Layout&
 BakeProgress Baker::step(double seconds) {
     auto t0 = Clock::now();
     while (impl_->stats.directionsDone < impl_->options.directions) {
-        impl_->bakeDirection(impl_->stats.directionsDone);
+        const int k = impl_->stats.directionsDone;
+        while (impl_->stats.directionsDone == k) impl_->stepTile();
         if (secondsSince(t0) >= seconds) break;
     }
     impl_->stats.peakGpuBytes = MemoryTracker::gpu().peak();
     return progress();
 }
 
-BakeProgress Baker::progress() const { return {impl_->stats.directionsDone, impl_->options.directions}; }
+BakeProgress Baker::stepTiles(double seconds) {
+    auto t0 = Clock::now();
+    while (impl_->stats.directionsDone < impl_->options.directions) {
+        impl_->stepTile();
+        if (secondsSince(t0) >= seconds) break;
+    }
+    impl_->stats.peakGpuBytes = MemoryTracker::gpu().peak();
+    return progress();
+}
+
+BakeProgress Baker::progress() const {
+    return {impl_->stats.directionsDone, impl_->options.directions, impl_->directionActive};
+}
 
 LightmapPages Baker::readLightmaps() {
     Impl& m = *impl_;
@@ -939,7 +780,14 @@ Baker::BundleCapture Baker::captureBundle(const glm::vec3& dir) {
     CHECK_LE(m.gridSize, m.maxTileSize);
     BundleCapture cap;
     cap.dir = glm::normalize(dir);
-    m.traceBundle(cap.dir, glm::vec2(0.0f), 12345u,
+    // the uniform grid as one tile, everything drawn
+    TilerOptions one = m.tilerOptions;
+    one.uniform = true;
+    one.fixedPixelSize = m.pixelSize;
+    one.cull = false;
+    one.nodeCapacity = 1e300;
+    one.maxTilePixels = m.gridSize;
+    m.tracer->run(m.bundleFrame(cap.dir, glm::vec2(0.0f), true), one, 12345u, false,
         [&](const TileFrame& f, uint32_t) -> GLuint {
             cap.u = f.u;
             cap.v = f.v;
@@ -948,14 +796,14 @@ Baker::BundleCapture Baker::captureBundle(const glm::vec3& dir) {
             cap.width = f.window.width;
             cap.height = f.window.height;
             return 0;  // no update
-        },
-        false, true);
-    glGetNamedBufferSubData(m.counterBuffer.id(), 0, 4, &cap.nodeCount);
+        });
+    cap.nodeCount = m.tracer->lastNodeCount();
     if (cap.width == 0) return cap;  // nothing drawn
-    std::vector<uint32_t> heads(size_t(m.headSide) * m.headSide);
-    glGetTextureImage(m.heads.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, GLsizei(heads.size() * 4), heads.data());
+    const int headSide = m.tracer->headSide();
+    std::vector<uint32_t> heads(size_t(headSide) * headSide);
+    glGetTextureImage(m.tracer->heads().id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, GLsizei(heads.size() * 4), heads.data());
     std::vector<shared::Node> nodes(std::max<uint32_t>(cap.nodeCount, 1));
-    glGetNamedBufferSubData(m.nodeBuffer.id(), 0, GLsizeiptr(nodes.size() * sizeof(shared::Node)), nodes.data());
+    glGetNamedBufferSubData(m.tracer->nodes().id(), 0, GLsizeiptr(nodes.size() * sizeof(shared::Node)), nodes.data());
     cap.depths.resize(size_t(cap.width) * cap.height);
     cap.flags.resize(cap.depths.size());
     cap.radiance.resize(cap.depths.size());
@@ -963,7 +811,7 @@ Baker::BundleCapture Baker::captureBundle(const glm::vec3& dir) {
         for (int x = 0; x < cap.width; ++x) {
             std::vector<std::pair<float, uint32_t>> list;
             uint32_t steps = 0;
-            for (uint32_t i = heads[size_t(y) * m.headSide + x]; i != END_OF_LIST; i = nodes[i].next) {
+            for (uint32_t i = heads[size_t(y) * headSide + x]; i != END_OF_LIST; i = nodes[i].next) {
                 if (i >= cap.nodeCount || ++steps > cap.nodeCount) {
                     cap.listsWellFormed = false;
                     break;
@@ -1017,6 +865,11 @@ struct CheckpointHeader {
 
 Status Baker::saveCheckpoint(const std::string& path) {
     Impl& m = *impl_;
+    // a checkpoint holds whole directions: finish the one in flight (the same tiles an uninterrupted bake draws)
+    if (m.directionActive) {
+        const int k = m.stats.directionsDone;
+        while (m.stats.directionsDone == k) m.stepTile();
+    }
     const int res = m.layout.resolution;
     std::vector<glm::uvec2> raw(size_t(res) * res * m.layout.pageCount);
     glGetTextureImage(m.accum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, GLsizei(raw.size() * 8), raw.data());
@@ -1072,7 +925,7 @@ uint32_t Baker::lightmapTextureId() const { return impl_->resolved.id(); }
 Baker::BundleGrid Baker::bundleGrid() const {
     const Impl& m = *impl_;
     BundleGrid g;
-    if (m.lastLeaves.empty()) {
+    if (m.stats.leavesPerDirection.empty() || m.tracer->leaves().empty()) {
         // before any direction: the uniform grid of direction 0
         if (m.directions.empty()) return g;
         g.dir = m.directions[0];
@@ -1084,17 +937,18 @@ Baker::BundleGrid Baker::bundleGrid() const {
         return g;
     }
     // the latest direction: the finest leaf's pixels, and its side as the tile step
-    g.dir = m.lastFrame.dir;
-    g.u = m.lastFrame.u;
-    g.v = m.lastFrame.v;
-    g.origin = glm::vec2(m.lastFrame.origin);
-    const BundleLeaf* finest = &m.lastLeaves[0];
-    for (const BundleLeaf& l : m.lastLeaves)
+    const BundleFrame& frame = m.tracer->frame();
+    g.dir = frame.dir;
+    g.u = frame.u;
+    g.v = frame.v;
+    g.origin = glm::vec2(frame.origin);
+    const BundleLeaf* finest = &m.tracer->leaves()[0];
+    for (const BundleLeaf& l : m.tracer->leaves())
         if (l.extent / l.pixels < finest->extent / finest->pixels) finest = &l;
-    g.pixelSize = float(finest->extent * m.lastFrame.size / finest->pixels);
-    g.gridSize = int(std::ceil(m.lastFrame.size / g.pixelSize - 1e-6));
+    g.pixelSize = float(finest->extent * frame.size / finest->pixels);
+    g.gridSize = int(std::ceil(frame.size / g.pixelSize - 1e-6));
     g.tileStep = std::max(1, finest->pixels);
-    g.tiles = m.stats.tilesPerDirection.empty() ? 0 : m.stats.tilesPerDirection.back();
+    g.tiles = m.tracer->tilesThisDirection();
     return g;
 }
 

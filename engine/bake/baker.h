@@ -110,6 +110,7 @@ struct BakeStats {
 struct BakeProgress {
     int directionsDone = 0;
     int directionsTotal = 0;
+    bool midDirection = false;  // stepTiles stopped between a direction's tiles
     bool done() const { return directionsDone >= directionsTotal; }
 };
 
@@ -133,6 +134,11 @@ public:
     // unless done). Deterministic whatever the budget: the same directions in
     // the same order give the same bytes.
     BakeProgress step(double seconds);
+    // The same, tile by tile: stops once `seconds` have passed (after at least
+    // one tile), possibly between a direction's tiles, so one call costs about
+    // one tile, not one direction (the viewer's frame budget). The tiles and
+    // their order are those of step(): the same bytes in the end.
+    BakeProgress stepTiles(double seconds);
     BakeProgress progress() const;
 
     // Checkpoints: the accumulators and progress, written atomically. A bake

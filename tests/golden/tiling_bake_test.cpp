@@ -128,6 +128,35 @@ TEST(TilingBake, CullingChangesNothing) {
     EXPECT_EQ(differingTexels(on, off), 0u);
 }
 
+// The viewer steps tile by tile (a frame need not hold a whole direction):
+// the same tiles in the same order, so the same bits as whole directions.
+TEST(TilingBake, SteppingByTileGivesTheSameBits) {
+    BB_REQUIRE_GL();
+    const std::string city = generateCity("steps", "--seed 4");
+    ASSERT_FALSE(city.empty()) << "scripts/generate_city.py failed";
+    BakeOptions o = cityOptions();
+    o.memoryBudget = 1 << 20;
+    const Baked whole = bakeCity(city, o);
+    ASSERT_TRUE(whole.error.empty()) << whole.error;
+
+    SceneBake bake = makeBake(city, cityLayout(), o);
+    ASSERT_TRUE(bake) << bake.error;
+    int calls = 0, callsMidDirection = 0;
+    for (BakeProgress p = bake.baker->progress(); !p.done(); ++calls) {
+        p = bake.baker->stepTiles(0.0);
+        callsMidDirection += p.midDirection;
+    }
+    Baked tiled;
+    tiled.accumulators = bake.baker->readAccumulators();
+    tiled.stats = bake.baker->stats();
+    std::printf("[tiling] %d stepTiles calls for %lld tiles, %d of them ended mid-direction\n", calls,
+                (long long)tiled.stats.tilesDrawn, callsMidDirection);
+    EXPECT_EQ(int64_t(calls), tiled.stats.tilesDrawn);  // one tile per call
+    EXPECT_GT(callsMidDirection, 0);
+    EXPECT_EQ(tiled.stats.tilesDrawn, whole.stats.tilesDrawn);
+    EXPECT_EQ(differingTexels(whole, tiled), 0u);
+}
+
 // The projected-area prediction per tile on three generated sizes, cut into
 // several tiles by a small budget: median within 20 %, p10 >= 0.5, p90 <= 2,
 // under 1 % of tiles overflowing.

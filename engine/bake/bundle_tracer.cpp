@@ -1,0 +1,219 @@
+#include "bake/bundle_tracer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "bake/rounding.h"
+#include "core/check.h"
+#include "gl/gl.h"
+#include "gl/shader.h"
+#include "glsl/shared/bundle_layout.h"
+
+namespace bb {
+namespace {
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+}  // namespace
+
+void setFrameUniforms(GLuint program, const TileFrame& f) {
+    glUniform3fv(glGetUniformLocation(program, "bundleDir"), 1, &f.d.x);
+    glUniform3fv(glGetUniformLocation(program, "bundleU"), 1, &f.u.x);
+    glUniform3fv(glGetUniformLocation(program, "bundleV"), 1, &f.v.x);
+    glUniform2fv(glGetUniformLocation(program, "rootOrigin"), 1, &f.rootOrigin.x);
+    glUniform1f(glGetUniformLocation(program, "rootSize"), f.rootSize);
+    glUniform2f(glGetUniformLocation(program, "leafMin"), float(f.leaf.min.x), float(f.leaf.min.y));
+    glUniform1f(glGetUniformLocation(program, "leafExtent"), float(f.leaf.extent));
+    glUniform1i(glGetUniformLocation(program, "leafPixels"), f.leaf.pixels);
+    glUniform1f(glGetUniformLocation(program, "pixelSize"), f.pixelSize);
+    glUniform2i(glGetUniformLocation(program, "tileOffset"), f.window.x, f.window.y);
+    glUniform2i(glGetUniformLocation(program, "tileSize"), f.window.width, f.window.height);
+}
+
+Expected<std::unique_ptr<BundleTracer>> BundleTracer::create(const BundleScene& scene, const BundleLimits& limits,
+                                                             const std::string& defines, BakeStats* stats) {
+    std::unique_ptr<BundleTracer> t(new BundleTracer());
+    auto program = gl::buildProgram({"bundle/append.vert", "bundle/append.frag"}, defines);
+    if (!program) return program.status();
+    t->append_ = std::move(program.value());
+    t->scene_ = scene;
+    t->limits_ = limits;
+    t->stats_ = stats;
+    t->counter_ = gl::Buffer::create("bundle node counter", 4, nullptr, GL_DYNAMIC_STORAGE_BIT);
+    t->ensureNodes(limits.predict ? std::min<int64_t>(limits.nodeCapacity, 1 << 16) : limits.nodeCapacity);
+    t->ensureHeads(64);
+    t->fbo_ = gl::Framebuffer::create("bundle framebuffer (no attachments)");
+    glNamedFramebufferParameteri(t->fbo_.id(), GL_FRAMEBUFFER_DEFAULT_WIDTH, limits.maxTileSize);
+    glNamedFramebufferParameteri(t->fbo_.id(), GL_FRAMEBUFFER_DEFAULT_HEIGHT, limits.maxTileSize);
+    return t;
+}
+
+void BundleTracer::ensureNodes(int64_t nodes) {
+    nodes = std::min(nodes, limits_.nodeCapacity);
+    if (nodes <= nodeAllocated_) return;
+    // grow by at least half, so a run of growing tiles reallocates a few times only
+    nodes = std::min(std::max(nodes, nodeAllocated_ + nodeAllocated_ / 2), limits_.nodeCapacity);
+    nodes_ = gl::Buffer();  // free first: the budget is for one buffer
+    nodes_ = gl::Buffer::create("bundle nodes", nodes * int64_t(sizeof(shared::Node)), nullptr, 0);
+    nodeAllocated_ = nodes;
+    stats_->nodeBufferBytes = std::max<int64_t>(stats_->nodeBufferBytes, nodes_.bytes());
+}
+
+void BundleTracer::ensureHeads(int side) {
+    if (side <= headSide_) return;
+    int s = 64;
+    while (s < side) s *= 2;
+    s = std::min(s, limits_.maxTileSize);
+    heads_ = gl::Texture();
+    heads_ = gl::Texture::create2D("bundle head pointers", GL_R32UI, s, s);
+    headSide_ = s;
+    stats_->headImageBytes = std::max<int64_t>(stats_->headImageBytes, heads_.bytes());
+}
+
+void BundleTracer::drawClusters(const std::vector<uint32_t>& ids, bool receiversOnly) {
+    const std::vector<Cluster>& clusters = *scene_.clusters;
+    if (receiversOnly) {
+        // clusters without a texel centre have nothing to update
+        std::vector<uint32_t> receivers;
+        for (uint32_t i : ids)
+            if (clusters[i].maxImportance > 0.0f) receivers.push_back(i);
+        clusterRanges(clusters, receivers, drawFirst_, drawCount_);
+    } else {
+        clusterRanges(clusters, ids, drawFirst_, drawCount_);
+    }
+    if (!drawFirst_.empty())
+        glMultiDrawArrays(GL_TRIANGLES, drawFirst_.data(), drawCount_.data(), GLsizei(drawFirst_.size()));
+    int64_t triangles = 0;
+    for (int32_t c : drawCount_) triangles += c / 3;
+    if (recordStats_) (receiversOnly ? stats_->updateTrianglesDrawn : stats_->bundleTrianglesDrawn) += triangles;
+}
+
+void BundleTracer::begin(const BundleFrame& frame, const TilerOptions& options, uint32_t seed, bool recordStats) {
+    auto t0 = Clock::now();
+    frame_ = frame;
+    options_ = options;
+    seed_ = seed;
+    recordStats_ = recordStats;
+    views_ = projectClusters(*scene_.mesh, *scene_.clusters, frame);
+    tiling_ = tileBundle(*scene_.clusters, views_, frame.size, options);
+    work_.assign(tiling_.tiles.rbegin(), tiling_.tiles.rend());
+    tiles_ = 0;
+    if (recordStats) {
+        stats_->secondsTiling += secondsSince(t0);
+        stats_->leavesPerDirection.push_back(int(tiling_.leaves.size()));
+        if (work_.empty()) stats_->tilesPerDirection.push_back(0);
+    }
+}
+
+void BundleTracer::run(const BundleFrame& frame, const TilerOptions& options, uint32_t seed, bool recordStats,
+                       const UpdateFn& update) {
+    begin(frame, options, seed, recordStats);
+    while (!done()) next(update);
+}
+
+void BundleTracer::next(const UpdateFn& update) {
+    CHECK(!work_.empty());
+    Tile tile = std::move(work_.back());
+    work_.pop_back();
+    TileFrame f;
+    f.d = frame_.dir;
+    f.u = frame_.u;
+    f.v = frame_.v;
+    f.rootOrigin = glm::vec2(frame_.origin);
+    f.rootSize = float(frame_.size);
+    f.leaf = tiling_.leaves[size_t(tile.leaf)];
+    f.window = tile.window;
+    f.pixelSize = float(tiling_.pixelSize(tile.leaf));
+    // per direction and leaf, never per tile: tiles change with the budget, the bits must not
+    const uint32_t leafSeed = pcgHash(seed_ ^ pcgHash(uint32_t(tile.leaf) * 7919u + 17u));
+    // buffers sized from the prediction (a quarter of margin), within the budget
+    if (limits_.predict) ensureNodes(int64_t(std::ceil(1.25 * tile.predictedNodes)) + 1024);
+    ensureHeads(std::max(tile.window.width, tile.window.height));
+
+    auto tb = Clock::now();
+    {
+        gl::DebugGroup group("bundle pass");
+        const uint32_t endOfList = END_OF_LIST, zero = 0;
+        glClearTexSubImage(heads_.id(), 0, 0, 0, 0, tile.window.width, tile.window.height, 1, GL_RED_INTEGER,
+                           GL_UNSIGNED_INT, &endOfList);
+        glNamedBufferSubData(counter_.id(), 0, 4, &zero);
+        glUseProgram(append_.id());
+        setFrameUniforms(append_.id(), f);
+        glUniform1ui(append_.uniform("nodeCapacity"), uint32_t(nodeAllocated_));
+        glUniform1ui(append_.uniform("randomSeed"), leafSeed);
+        // the leaf's grid in a power-of-two viewport (glsl/bundle/append.vert) shifted so the
+        // tile lands at (0, 0); the scissor keeps the rest out
+        int viewportPixels = 1;
+        while (viewportPixels < f.leaf.pixels) viewportPixels *= 2;
+        glUniform1i(append_.uniform("viewportPixels"), viewportPixels);
+        glUniform1f(append_.uniform("subpixelSteps"), float(1 << limits_.subpixelBits));
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
+        glViewport(-tile.window.x, -tile.window.y, viewportPixels, viewportPixels);
+        glEnable(GL_SCISSOR_TEST);
+        glScissor(0, 0, tile.window.width, tile.window.height);
+        glBindVertexArray(scene_.vertexArray);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, scene_.triangleBuffer);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_NODES, nodes_.id());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_VERTICES, scene_.vertexBuffer);
+        glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, BINDING_NODE_COUNTER, counter_.id());
+        glBindImageTexture(BINDING_HEADS, heads_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+        glBindTextureUnit(BINDING_RADIANCE, scene_.radiance);
+        drawClusters(tile.clusters, false);
+        glDisable(GL_SCISSOR_TEST);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                        GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    }
+    uint32_t count = 0;
+    glGetNamedBufferSubData(counter_.id(), 0, 4, &count);
+    lastCount_ = count;
+    ++tiles_;
+    if (recordStats_) {
+        stats_->secondsBundle += secondsSince(tb);
+        ++stats_->tilesDrawn;
+    }
+    if (int64_t(count) > nodeAllocated_) {
+        // overflow: nothing is used from this draw. Redraw into a buffer of
+        // the measured size if the budget holds it, else in four quarters.
+        if (recordStats_) ++stats_->overflows;
+        if (int64_t(count) <= limits_.nodeCapacity && limits_.predict) {
+            ensureNodes(int64_t(count));
+            work_.push_back(std::move(tile));
+        } else {
+            CHECK(tile.window.width > 1 || tile.window.height > 1);
+            auto quarters = splitWindow(tile.window);
+            for (auto it = quarters.rbegin(); it != quarters.rend(); ++it)
+                work_.push_back(makeTile(tiling_, tile.leaf, *it, *scene_.clusters, views_, tile.clusters, options_.cull));
+        }
+        return;
+    }
+    if (recordStats_) {
+        stats_->fragments += count;
+        stats_->peakNodesPerTile = std::max<int64_t>(stats_->peakNodesPerTile, count);
+        if (count > 0) stats_->predictedOverActual.push_back(tile.predictedNodes / count);
+        stats_->tilePixelSizes.push_back(f.pixelSize);
+    }
+    if (count > 0) {
+        auto tu = Clock::now();
+        gl::DebugGroup group("update pass");
+        glBindFramebuffer(GL_FRAMEBUFFER, scene_.pageFramebuffer);
+        glViewport(0, 0, scene_.pageResolution, scene_.pageResolution);
+        if (GLuint program = update(f, count)) {
+            setFrameUniforms(program, f);
+            glUniform1ui(glGetUniformLocation(program, "nodeCount"), count);
+            glBindVertexArray(scene_.vertexArray);
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, scene_.triangleBuffer);
+            glBindImageTexture(BINDING_HEADS, heads_.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_NODES, nodes_.id());
+            drawClusters(tile.clusters, true);
+            glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+        }
+        if (recordStats_) {
+            glFinish();
+            stats_->secondsUpdate += secondsSince(tu);
+        }
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (recordStats_ && work_.empty()) stats_->tilesPerDirection.push_back(tiles_);
+}
+
+}  // namespace bb

@@ -1,0 +1,121 @@
+// The bundle pass and the tile loop of one direction (DESIGN.md steps 5-7):
+// the tiler's tiles (engine/tiler/tiler.h) are drawn one at a time into
+// per-pixel linked lists (head pointers in an r32ui image, 12-byte nodes in
+// an SSBO, one atomic counter), and each tile that fits is handed to an
+// update pass (the caller's program) that draws the tile's receiving
+// clusters in light map space.
+//
+// Memory: the node buffer and the head image start small and grow to what
+// the tiles predict (a quarter of margin), never past the budget's limits.
+// A tile whose counter exceeds the buffer is redrawn into a buffer of the
+// measured size if the budget holds it, else cut into quarters and redrawn:
+// no fragment is dropped. Nothing a node holds depends on the tile that drew
+// it, so any budget gives the same bits.
+//
+// Requires a current GL 4.3 context for its whole life.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "bake/baker.h"
+#include "core/status.h"
+#include "gl/objects.h"
+#include "tiler/tiler.h"
+
+namespace bb {
+
+// Where one tile lies: the direction's frame, its leaf and its window of the
+// leaf's grid (glsl/lib/bundle_frame.glsl reads these as uniforms).
+struct TileFrame {
+    glm::vec3 d{0.0f}, u{0.0f}, v{0.0f};
+    glm::vec2 rootOrigin{0.0f};
+    float rootSize = 1.0f;
+    BundleLeaf leaf;
+    TileWindow window;
+    float pixelSize = 1.0f;
+};
+
+// Sets the bundle_frame.glsl uniforms of `program` (bound).
+void setFrameUniforms(GLuint program, const TileFrame& f);
+
+// What the tracer draws (owned by the Baker; alive as long as the tracer).
+struct BundleScene {
+    const BakeMesh* mesh = nullptr;
+    const std::vector<Cluster>* clusters = nullptr;
+    GLuint vertexArray = 0, vertexBuffer = 0, triangleBuffer = 0;
+    GLuint radiance = 0;      // outgoing radiance per texel (the bundle pass reads it)
+    GLuint pageFramebuffer = 0;
+    int pageResolution = 0;
+};
+
+struct BundleLimits {
+    int64_t nodeCapacity = 0;  // nodes the budget allows in one tile (<= GL_MAX_SHADER_STORAGE_BLOCK_SIZE / 12)
+    int maxTileSize = 64;      // head image side the budget allows (<= GL_MAX_TEXTURE_SIZE, viewport)
+    int subpixelBits = 8;      // GL_SUBPIXEL_BITS
+    bool predict = true;       // size the buffers from the predictions (false: allocate the budget at once)
+};
+
+class BundleTracer {
+public:
+    // Binds the update program, sets its uniforms (other than the frame's and
+    // the node count, which the tracer sets) and returns it; 0 skips the update.
+    using UpdateFn = std::function<GLuint(const TileFrame&, uint32_t nodeCount)>;
+
+    // Errors: the bundle program failed to build (one line).
+    static Expected<std::unique_ptr<BundleTracer>> create(const BundleScene& scene, const BundleLimits& limits,
+                                                          const std::string& defines, BakeStats* stats);
+
+    // Tiles a direction: the clusters projected along frame.dir, the leaves
+    // and tiles of tileBundle. recordStats: the direction counts in BakeStats
+    // (bakes; not the sun or captures).
+    void begin(const BundleFrame& frame, const TilerOptions& options, uint32_t seed, bool recordStats);
+    bool done() const { return work_.empty(); }
+    // Draws the next tile (one bundle draw) and, if it fit, its update.
+    void next(const UpdateFn& update);
+    // All of a direction's tiles.
+    void run(const BundleFrame& frame, const TilerOptions& options, uint32_t seed, bool recordStats,
+             const UpdateFn& update);
+
+    // The latest direction's tiling (viewer overlays) and the latest tile's
+    // lists (captures: head image row stride headSide()).
+    const BundleFrame& frame() const { return frame_; }
+    const std::vector<BundleLeaf>& leaves() const { return tiling_.leaves; }
+    int tilesThisDirection() const { return tiles_; }
+    const gl::Texture& heads() const { return heads_; }
+    int headSide() const { return headSide_; }
+    const gl::Buffer& nodes() const { return nodes_; }
+    uint32_t lastNodeCount() const { return lastCount_; }
+
+private:
+    BundleTracer() = default;
+    void ensureNodes(int64_t nodes);
+    void ensureHeads(int side);
+    void drawClusters(const std::vector<uint32_t>& ids, bool receiversOnly);
+
+    BundleScene scene_;
+    BundleLimits limits_;
+    BakeStats* stats_ = nullptr;
+    gl::Program append_;
+    gl::Buffer nodes_, counter_;
+    gl::Texture heads_;
+    gl::Framebuffer fbo_;
+    int64_t nodeAllocated_ = 0;
+    int headSide_ = 0;
+    std::vector<int32_t> drawFirst_, drawCount_;  // scratch: multi-draw ranges
+
+    // the direction in progress
+    BundleFrame frame_;
+    TilerOptions options_;
+    std::vector<ClusterView> views_;
+    DirectionTiling tiling_;
+    std::vector<Tile> work_;  // back() is next
+    uint32_t seed_ = 0;
+    bool recordStats_ = false;
+    int tiles_ = 0;
+    uint32_t lastCount_ = 0;
+};
+
+}  // namespace bb
