@@ -1,31 +1,26 @@
-#include "layout/bake_mesh_gl.h"
+// The Baker: setup (programs, meta pass, importance -> clusters, buffers),
+// the public API, read-backs and captures. The stages live beside it (see
+// baker_impl.h).
 #include "bake/baker.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cstring>
 #include <cmath>
 #include <numeric>
 
-#include "bake/bundle_tracer.h"
+#include "bake/baker_impl.h"
 #include "bake/directions.h"
 #include "core/check.h"
 #include "core/log.h"
 #include "core/memory.h"
 #include "gl/gl.h"
-#include <glm/gtc/matrix_transform.hpp>
-#include "gl/objects.h"
 #include "gl/shader.h"
 #include "glsl/shared/bundle_layout.h"
 #include "importance/importance_gl.h"
-#include "tiler/tiler.h"
+#include "layout/bake_mesh_gl.h"
 
 namespace bb {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
 
 // Per texel of every page, the covered texel whose value it shows: itself if
 // covered, else the nearest covered texel within `radius` texels (Chebyshev
@@ -60,64 +55,6 @@ std::vector<int32_t> dilationSources(const std::vector<uint8_t>& covered, int re
 
 }  // namespace
 
-struct Baker::Impl {
-    BakeOptions options;
-    BakeMesh mesh;
-    Layout layout;
-    std::vector<Material> materials;
-    std::vector<DirectionalLight> lights;
-    BakeStats stats;
-    std::vector<glm::vec3> directions;
-
-    // scene frame
-    glm::vec3 sphereCenter{0.0f};
-    float sphereRadius = 1.0f;
-    float pixelSize = 1.0f;
-    int gridSize = 1;         // pixels across the uniform bundle (--tiling uniform, captures)
-    int maxTileSize = 2048;   // largest head image side the budget allows
-    float depthBias = 0.0f;
-    double historyPower = 0.0;
-    double accumScale = 1.0;  // stored sums are true sums / accumScale
-    std::vector<double> projectedArea;  // per triangle world area
-    std::vector<Cluster> clusters;      // the mesh in culling units (engine/tiler)
-    TilerOptions tilerOptions;
-
-    // GL objects
-    gl::Buffer vertexBuffer, triangleBuffer, metaIndexBuffer;
-    gl::VertexArray vao;
-    gl::Texture albedoMap, emissionMap, accum, sunMap, radiance, resolved, envTexture, dilationSource;
-    gl::Framebuffer pageFbo, metaFbo;
-    gl::Program updateProgram, sunProgram, resolveProgram, rescaleProgram, metaProgram, distanceProgram,
-        emitterProgram;
-    gl::Texture emitterMap;
-    std::vector<glm::vec3> textureMeans;  // mean linear RGB of each scene texture (explicit emitters)
-    std::vector<gl::Texture> materialTextures;
-    int64_t nodeCapacity = 0;     // nodes the budget allows in one tile
-    int subpixelBits = 8;         // GL_SUBPIXEL_BITS
-    std::unique_ptr<BundleTracer> tracer;
-    // the direction in progress (Baker::stepTiles can stop between its tiles)
-    bool directionActive = false;
-    BundleTracer::UpdateFn directionUpdate;
-
-    Status init(const Scene& scene);
-    Status buildPrograms();
-    void uploadMesh();
-    void metaPass(const Scene& scene);
-    void bakeSun();
-    bool useExplicitEmitters() const;
-    void bakeEmitters();
-    // The root square of direction d: the uniform grid, or the adaptive root.
-    BundleFrame bundleFrame(const glm::vec3& d, glm::vec2 jitter, bool uniformGrid) const;
-    // All tiles of direction d (bundle_tracer.h), each followed by `update`.
-    template <class UpdateFn>
-    void traceBundle(const glm::vec3& d, glm::vec2 jitter, uint32_t seed, UpdateFn update, bool recordStats);
-    // Direction k: the history ramp, then its tiles one by one, then the radiance refresh.
-    void beginDirection(int k);
-    void stepTile();
-    void finishDirection(int k);
-    void resolveInto(bool radianceOut, gl::Texture& target);
-    void dispatchPages(GLuint program);
-};
 
 nlohmann::json BakeStats::toJson() const {
     nlohmann::json j;
@@ -472,227 +409,9 @@ BundleFrame Baker::Impl::bundleFrame(const glm::vec3& d, glm::vec2 jitter, bool 
     return frame;
 }
 
-template <class UpdateFn>
-void Baker::Impl::traceBundle(const glm::vec3& d, glm::vec2 jitter, uint32_t seed, UpdateFn update, bool recordStats) {
+void Baker::Impl::traceBundle(const glm::vec3& d, glm::vec2 jitter, uint32_t seed, const BundleTracer::UpdateFn& update,
+                              bool recordStats) {
     tracer->run(bundleFrame(d, jitter, tilerOptions.uniform), tilerOptions, seed, recordStats, update);
-}
-
-void Baker::Impl::bakeSun() {
-    if (lights.empty()) return;
-    int j = std::max(1, options.sunJitter);
-    for (size_t li = 0; li < lights.size(); ++li) {
-        const auto& light = lights[li];
-        glm::vec3 irradiance = light.irradiance;
-        for (int jy = 0; jy < j; ++jy)
-            for (int jx = 0; jx < j; ++jx) {
-                glm::vec2 jitter((jx + 0.5f) / j - 0.5f, (jy + 0.5f) / j - 0.5f);
-                traceBundle(glm::normalize(light.direction), jitter, uint32_t(li * 1000 + jy * j + jx),
-                    [&](const TileFrame&, uint32_t) -> GLuint {
-                        glUseProgram(sunProgram.id());
-                        glUniform3fv(sunProgram.uniform("sunIrradiance"), 1, &irradiance.x);
-                        glUniform1f(sunProgram.uniform("depthBias"), depthBias);
-                        glBindImageTexture(BINDING_SUN, sunMap.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
-                        return sunProgram.id();
-                    },
-                    false);
-            }
-    }
-}
-
-bool Baker::Impl::useExplicitEmitters() const {
-    using D = BakeOptions::DirectLight;
-    if (options.directLight != D::Auto) return options.directLight == D::Explicit;
-    size_t emitters = 0;
-    double emitterArea = 0, area = 0;
-    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-        area += projectedArea[t];
-        if (mesh.triangles[t].flags & TRIANGLE_EMISSIVE) {
-            ++emitters;
-            emitterArea += projectedArea[t];
-        }
-    }
-    return emitters > 0 && emitters <= 1024 && emitterArea <= 0.25 * area;
-}
-
-void Baker::Impl::bakeEmitters() {
-    gl::DebugGroup group("explicit emitters");
-    // emitters and their sample counts, proportional to area x luminance (>= 1 each)
-    struct Emitter {
-        size_t triangle;
-        glm::vec3 radiance;
-        double power;
-        int samples = 1;
-    };
-    std::vector<Emitter> emitters;
-    double totalPower = 0;
-    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-        if (!(mesh.triangles[t].flags & TRIANGLE_EMISSIVE)) continue;
-        const Material& m = materials[mesh.triangles[t].material];
-        glm::vec3 le = m.emission * (m.emissionTexture >= 0 ? textureMeans[size_t(m.emissionTexture)] : glm::vec3(1.0f));
-        double power = projectedArea[t] * (0.2126 * le.r + 0.7152 * le.g + 0.0722 * le.b);
-        emitters.push_back({t, le, power});
-        totalPower += power;
-    }
-    if (emitters.empty()) return;
-    for (auto& e : emitters)
-        e.samples = std::max(1, int(std::lround(options.emitterSamples * (totalPower > 0 ? e.power / totalPower : 0.0))));
-
-    // auto: 4 cube texels per bundle pixel across (gridSize pixels span the
-    // scene's diameter). Measured on the Cornell box at 64^2 texels: 64^2
-    // faces raise the error from 4.3 % to 5.0 %, 256^2 and 512^2 give 4.3 %
-    // and 256^2 costs 0.3 s instead of 0.5 s.
-    int size = options.emitterShadowSize;
-    if (size <= 0) {
-        size = 64;
-        while (size < 4 * gridSize && size < 512) size *= 2;
-    }
-    gl::Texture cube = gl::Texture::createCube("emitter sample distances", GL_R32F, size);
-    glTextureParameteri(cube.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTextureParameteri(cube.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    gl::Texture depth = gl::Texture::create2D("emitter sample depth", GL_DEPTH_COMPONENT32F, size, size);
-    gl::Framebuffer fbo = gl::Framebuffer::create("emitter sample cube face");
-    glNamedFramebufferTexture(fbo.id(), GL_DEPTH_ATTACHMENT, depth.id(), 0);
-
-    const glm::vec3 faceDir[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-    const glm::vec3 faceUp[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
-    const float nearPlane = 1e-4f * sphereRadius, farPlane = 4.0f * sphereRadius;
-    const glm::mat4 projection = glm::perspective(glm::radians(90.0f), 1.0f, nearPlane, farPlane);
-    const float farValue = 1e30f;
-    const float normalOffset = 0.5f * pixelSize;
-    // Bias: a quarter bundle pixel, plus (in the shader) half a cube texel's
-    // footprint at the receiver's distance, the error of a nearest lookup.
-    // Kept well under a texel so walls one texel thick still cast shadows.
-    const float distanceBias = 0.25f * pixelSize;
-
-    for (const Emitter& e : emitters) {
-        const BakeVertex* v = &mesh.vertices[e.triangle * 3];
-        glm::vec3 a(v[0].position), b(v[1].position), c(v[2].position);
-        glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
-        bool doubleSided = mesh.triangles[e.triangle].flags & TRIANGLE_DOUBLE_SIDED;
-        glm::vec3 perSample = e.radiance / float(e.samples);
-        for (int i = 0; i < e.samples; ++i) {
-            // stratified point on the triangle: R2 sequence (Roberts 2018), folded
-            double su = std::fmod(0.5 + 0.7548776662466927 * (i + 1), 1.0);
-            double sv = std::fmod(0.5 + 0.5698402909980532 * (i + 1), 1.0);
-            if (su + sv > 1.0) {
-                su = 1.0 - su;
-                sv = 1.0 - sv;
-            }
-            glm::vec3 point = a + float(su) * (b - a) + float(sv) * (c - a) + n * (1e-4f * pixelSize);
-            // distance cube map
-            glUseProgram(distanceProgram.id());
-            glUniform3fv(distanceProgram.uniform("samplePoint"), 1, &point.x);
-            glEnable(GL_DEPTH_TEST);
-            glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
-            glViewport(0, 0, size, size);
-            for (int f = 0; f < 6; ++f) {
-                glNamedFramebufferTextureLayer(fbo.id(), GL_COLOR_ATTACHMENT0, cube.id(), 0, f);
-                glm::mat4 clipFromWorld = projection * glm::lookAt(point, point + faceDir[f], faceUp[f]);
-                glUniformMatrix4fv(distanceProgram.uniform("clipFromWorld"), 1, GL_FALSE, &clipFromWorld[0][0]);
-                glClearNamedFramebufferfv(fbo.id(), GL_COLOR, 0, &farValue);
-                glClearNamedFramebufferfi(fbo.id(), GL_DEPTH_STENCIL, 0, 1.0f, 0);
-                glDrawArrays(GL_TRIANGLES, 0, GLsizei(mesh.vertices.size()));
-            }
-            glDisable(GL_DEPTH_TEST);
-            // accumulate this sample's share into the direct map, page by page
-            glUseProgram(emitterProgram.id());
-            glUniform3fv(emitterProgram.uniform("emitterA"), 1, &a.x);
-            glUniform3fv(emitterProgram.uniform("emitterB"), 1, &b.x);
-            glUniform3fv(emitterProgram.uniform("emitterC"), 1, &c.x);
-            glUniform3fv(emitterProgram.uniform("emitterNormal"), 1, &n.x);
-            glUniform1i(emitterProgram.uniform("emitterDoubleSided"), doubleSided);
-            glUniform3fv(emitterProgram.uniform("radianceOverSamples"), 1, &perSample.x);
-            glUniform3fv(emitterProgram.uniform("samplePoint"), 1, &point.x);
-            glUniform1f(emitterProgram.uniform("normalOffset"), normalOffset);
-            glUniform1f(emitterProgram.uniform("distanceBias"), distanceBias);
-            glUniform1f(emitterProgram.uniform("footprintPerDistance"), 1.0f / float(size));
-            glBindTextureUnit(0, cube.id());
-            glBindImageTexture(BINDING_DIRECT, emitterMap.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
-            glBindFramebuffer(GL_FRAMEBUFFER, pageFbo.id());
-            glViewport(0, 0, layout.resolution, layout.resolution);
-            for (int page = 0; page < layout.pageCount; ++page) {
-                glUniform1i(emitterProgram.uniform("page"), page);
-                GLint first = GLint(mesh.pageFirstTriangle[page] * 3);
-                GLsizei count = GLsizei((mesh.pageFirstTriangle[page + 1] - mesh.pageFirstTriangle[page]) * 3);
-                if (count) glDrawArrays(GL_TRIANGLES, first, count);
-            }
-            glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
-            ++stats.emitterSampleCount;
-        }
-    }
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-}
-
-void Baker::Impl::beginDirection(int k) {
-    const glm::vec3 d = directions[size_t(k)];
-    // history ramp: weight min(k+1, K)^power relative to the stored scale
-    double rampEnd = std::max(1, options.directions / 2);
-    double weight = std::pow(std::min(double(k + 1), rampEnd), historyPower);
-    double sampleWeight = weight / accumScale;
-    if (sampleWeight > 16.0) {
-        gl::DebugGroup group("rescale accumulators");
-        glUseProgram(rescaleProgram.id());
-        glUniform1f(rescaleProgram.uniform("factor"), float(accumScale / weight));
-        glUniform1ui(rescaleProgram.uniform("randomSeed"), pcgHash(uint32_t(options.seed) ^ pcgHash(uint32_t(k) + 77u)));
-        glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
-        dispatchPages(rescaleProgram.id());
-        accumScale = weight;
-        sampleWeight = 1.0;
-    }
-    const uint32_t seed = pcgHash(uint32_t(options.seed) * 0x9E3779B1u ^ pcgHash(uint32_t(k)));
-    directionUpdate = [this, sampleWeight, seed](const TileFrame&, uint32_t) -> GLuint {
-        const bool useEnv = bool(envTexture);
-        glUseProgram(updateProgram.id());
-        glUniform1f(updateProgram.uniform("sampleWeight"), float(sampleWeight));
-        // per direction, not per tile: each texel is updated once per direction, and tiles change with the budget
-        glUniform1ui(updateProgram.uniform("randomSeed"), seed);
-        glUniform3fv(updateProgram.uniform("sky"), 1, &options.sky.x);
-        glUniform1i(updateProgram.uniform("useEnv"), useEnv);
-        glUniform1f(updateProgram.uniform("depthBias"), depthBias);
-        if (useEnv) glBindTextureUnit(BINDING_ENV, envTexture.id());
-        glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
-        return updateProgram.id();
-    };
-    tracer->begin(bundleFrame(d, glm::vec2(0.0f), tilerOptions.uniform), tilerOptions, seed, true);
-    directionActive = true;
-}
-
-void Baker::Impl::stepTile() {
-    const int k = stats.directionsDone;
-    if (!directionActive) beginDirection(k);
-    if (!tracer->done()) tracer->next(directionUpdate);
-    if (tracer->done()) finishDirection(k);
-}
-
-void Baker::Impl::finishDirection(int k) {
-    directionActive = false;
-    stats.updatedTexels += stats.coveredTexels;
-    // Refresh the outgoing radiance the next bundles read. Every direction at
-    // first, when each one adds a bounce; later every k/32 directions (at most
-    // 8): the estimate then moves slowly and the resolve is a pass over every page.
-    const int interval = std::clamp(k / 32, 1, 8);
-    if ((k + 1) % interval == 0 || k + 1 == options.directions) {
-        auto tr = Clock::now();
-        resolveInto(true, radiance);
-        glFinish();
-        stats.secondsResolve += secondsSince(tr);
-    }
-    ++stats.directionsDone;
-}
-
-void Baker::Impl::resolveInto(bool radianceOut, gl::Texture& target) {
-    gl::DebugGroup group("resolve");
-    glUseProgram(resolveProgram.id());
-    glUniform1i(resolveProgram.uniform("radianceOut"), radianceOut);
-    glUniform1i(resolveProgram.uniform("includeEmission"), !stats.explicitEmitters);
-    glBindImageTexture(7, emitterMap.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
-    glBindImageTexture(1, accum.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RG32UI);
-    glBindImageTexture(2, sunMap.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
-    glBindImageTexture(3, albedoMap.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
-    glBindImageTexture(4, emissionMap.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
-    glBindImageTexture(5, target.id(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glBindImageTexture(6, dilationSource.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_R32I);
-    dispatchPages(resolveProgram.id());
 }
 
 Baker::Baker(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -828,91 +547,6 @@ Baker::BundleCapture Baker::captureBundle(const glm::vec3& dir) {
             }
         }
     return cap;
-}
-
-namespace {
-constexpr char CHECKPOINT_MAGIC[8] = {'B', 'B', 'C', 'K', 'P', 'T', '0', '2'};
-
-uint64_t fnv1a(const void* data, size_t bytes, uint64_t h = 1469598103934665603ull) {
-    const auto* p = static_cast<const uint8_t*>(data);
-    for (size_t i = 0; i < bytes; ++i) h = (h ^ p[i]) * 1099511628211ull;
-    return h;
-}
-
-// What a checkpoint must match to be resumed: geometry, layout and every option that changes the bytes.
-uint64_t checkpointKey(const BakeMesh& mesh, const Layout& layout, const BakeOptions& o, double historyPower) {
-    uint64_t h = fnv1a(mesh.vertices.data(), mesh.vertices.size() * sizeof(BakeVertex));
-    h = fnv1a(mesh.triangles.data(), mesh.triangles.size() * sizeof(BakeTriangle), h);
-    const int64_t ints[] = {layout.resolution, layout.pageCount, o.directions, o.bundleResolution, o.memoryBudget, int64_t(o.tiling),
-                            int64_t(o.seed), int64_t(o.rounding), o.sunJitter, o.environment ? 1 : 0};
-    h = fnv1a(ints, sizeof ints, h);
-    const double reals[] = {o.sky.r, o.sky.g, o.sky.b, historyPower};
-    h = fnv1a(reals, sizeof reals, h);
-    if (o.environment) h = fnv1a(o.environment->pixels.data(), o.environment->pixels.size() * sizeof(glm::vec3), h);
-    return h;
-}
-
-struct CheckpointHeader {
-    char magic[8];
-    uint64_t key;
-    int32_t directionsDone;
-    int32_t resolution;
-    int32_t pages;
-    int32_t pad;
-    double accumScale;
-};
-}  // namespace
-
-Status Baker::saveCheckpoint(const std::string& path) {
-    Impl& m = *impl_;
-    // a checkpoint holds whole directions: finish the one in flight (the same tiles an uninterrupted bake draws)
-    if (m.directionActive) {
-        const int k = m.stats.directionsDone;
-        while (m.stats.directionsDone == k) m.stepTile();
-    }
-    const int res = m.layout.resolution;
-    std::vector<glm::uvec2> raw(size_t(res) * res * m.layout.pageCount);
-    glGetTextureImage(m.accum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, GLsizei(raw.size() * 8), raw.data());
-    CheckpointHeader h{};
-    std::memcpy(h.magic, CHECKPOINT_MAGIC, 8);
-    h.key = checkpointKey(m.mesh, m.layout, m.options, m.historyPower);
-    h.directionsDone = m.stats.directionsDone;
-    h.resolution = res;
-    h.pages = m.layout.pageCount;
-    h.accumScale = m.accumScale;
-    // the radiance map too: it is refreshed on a schedule, so it can be older than the accumulators
-    std::vector<glm::vec4> radiance(raw.size());
-    glGetTextureImage(m.radiance.id(), 0, GL_RGBA, GL_FLOAT, GLsizei(radiance.size() * 16), radiance.data());
-    std::string bytes(reinterpret_cast<const char*>(&h), sizeof h);
-    bytes.append(reinterpret_cast<const char*>(raw.data()), raw.size() * sizeof(glm::uvec2));
-    bytes.append(reinterpret_cast<const char*>(radiance.data()), radiance.size() * sizeof(glm::vec4));
-    return io::writeFileAtomic(path, bytes);
-}
-
-Status Baker::loadCheckpoint(const std::string& path) {
-    Impl& m = *impl_;
-    std::FILE* f = std::fopen(path.c_str(), "rb");
-    if (!f) return Status::error("cannot read checkpoint " + path);
-    CheckpointHeader h{};
-    const int res = m.layout.resolution;
-    std::vector<glm::uvec2> raw(size_t(res) * res * m.layout.pageCount);
-    std::vector<glm::vec4> radiance(raw.size());
-    bool ok = std::fread(&h, sizeof h, 1, f) == 1 && std::memcmp(h.magic, CHECKPOINT_MAGIC, 8) == 0 &&
-              h.resolution == res && h.pages == m.layout.pageCount &&
-              std::fread(raw.data(), sizeof(glm::uvec2), raw.size(), f) == raw.size() &&
-              std::fread(radiance.data(), sizeof(glm::vec4), radiance.size(), f) == radiance.size();
-    std::fclose(f);
-    if (!ok) return Status::error(path + " is not a bundlebake checkpoint of this layout");
-    if (h.key != checkpointKey(m.mesh, m.layout, m.options, m.historyPower))
-        return Status::error(path + " was written for another scene or other bake options; remove it or bake without --resume");
-    if (h.directionsDone < 0 || h.directionsDone > m.options.directions)
-        return Status::error(path + ": corrupt progress count");
-    glTextureSubImage3D(m.accum.id(), 0, 0, 0, 0, res, res, m.layout.pageCount, GL_RG_INTEGER, GL_UNSIGNED_INT,
-                        raw.data());
-    glTextureSubImage3D(m.radiance.id(), 0, 0, 0, 0, res, res, m.layout.pageCount, GL_RGBA, GL_FLOAT, radiance.data());
-    m.stats.directionsDone = h.directionsDone;
-    m.accumScale = h.accumScale;
-    return Status::ok();
 }
 
 const BakeStats& Baker::stats() const { return impl_->stats; }

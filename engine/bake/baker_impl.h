@@ -1,0 +1,83 @@
+// The Baker's state, shared by the files of its stages (private to engine/bake):
+//   baker.cpp           setup (programs, meta pass, importance -> clusters,
+//                       buffers), the public API, read-backs, captures
+//   bundle_tracer.cpp   the bundle pass and a direction's tiles (engine/tiler)
+//   radiance_exchange.cpp  a direction: history ramp, update pass, resolve
+//   direct_light.cpp    the sun (shadow bundles) and explicit emitters
+//   checkpoint.cpp      checkpoints
+#pragma once
+
+#include <chrono>
+#include <memory>
+#include <vector>
+
+#include "bake/baker.h"
+#include "bake/bundle_tracer.h"
+#include "gl/objects.h"
+#include "tiler/tiler.h"
+
+namespace bb {
+
+using Clock = std::chrono::steady_clock;
+inline double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+struct Baker::Impl {
+    BakeOptions options;
+    BakeMesh mesh;
+    Layout layout;
+    std::vector<Material> materials;
+    std::vector<DirectionalLight> lights;
+    BakeStats stats;
+    std::vector<glm::vec3> directions;
+
+    // scene frame
+    glm::vec3 sphereCenter{0.0f};
+    float sphereRadius = 1.0f;
+    float pixelSize = 1.0f;
+    int gridSize = 1;         // pixels across the uniform bundle (--tiling uniform, captures)
+    int maxTileSize = 2048;   // largest head image side the budget allows
+    float depthBias = 0.0f;
+    double historyPower = 0.0;
+    double accumScale = 1.0;  // stored sums are true sums / accumScale
+    std::vector<double> projectedArea;  // per triangle world area
+    std::vector<Cluster> clusters;      // the mesh in culling units (engine/tiler)
+    TilerOptions tilerOptions;
+
+    // GL objects
+    gl::Buffer vertexBuffer, triangleBuffer, metaIndexBuffer;
+    gl::VertexArray vao;
+    gl::Texture albedoMap, emissionMap, accum, sunMap, radiance, resolved, envTexture, dilationSource;
+    gl::Framebuffer pageFbo, metaFbo;
+    gl::Program updateProgram, sunProgram, resolveProgram, rescaleProgram, metaProgram, distanceProgram,
+        emitterProgram;
+    gl::Texture emitterMap;
+    std::vector<glm::vec3> textureMeans;  // mean linear RGB of each scene texture (explicit emitters)
+    std::vector<gl::Texture> materialTextures;
+    int64_t nodeCapacity = 0;     // nodes the budget allows in one tile
+    int subpixelBits = 8;         // GL_SUBPIXEL_BITS
+    std::unique_ptr<BundleTracer> tracer;
+    // the direction in progress (Baker::stepTiles can stop between its tiles)
+    bool directionActive = false;
+    BundleTracer::UpdateFn directionUpdate;
+
+    Status init(const Scene& scene);
+    Status buildPrograms();
+    void uploadMesh();
+    void metaPass(const Scene& scene);
+    void bakeSun();
+    bool useExplicitEmitters() const;
+    void bakeEmitters();
+    // The root square of direction d: the uniform grid, or the adaptive root.
+    BundleFrame bundleFrame(const glm::vec3& d, glm::vec2 jitter, bool uniformGrid) const;
+    // All tiles of direction d (bundle_tracer.h), each followed by `update`.
+    void traceBundle(const glm::vec3& d, glm::vec2 jitter, uint32_t seed, const BundleTracer::UpdateFn& update,
+                     bool recordStats);
+    // Direction k: the history ramp, then its tiles one by one, then the radiance refresh.
+    void beginDirection(int k);
+    void stepTile();
+    void finishDirection(int k);
+    void resolveInto(bool radianceOut, gl::Texture& target);
+    void dispatchPages(GLuint program);
+};
+
+}  // namespace bb

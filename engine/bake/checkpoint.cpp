@@ -1,0 +1,104 @@
+// Checkpoints: the accumulators, the radiance map and the progress, written
+// atomically; a bake resumed from one ends on the bytes of an uninterrupted
+// bake. A checkpoint holds whole directions.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "bake/baker_impl.h"
+#include "bake/rounding.h"
+#include "core/check.h"
+#include "gl/gl.h"
+#include "glsl/shared/bundle_layout.h"
+#include <cstdio>
+
+#include "io/image_io.h"
+
+namespace bb {
+
+namespace {
+constexpr char CHECKPOINT_MAGIC[8] = {'B', 'B', 'C', 'K', 'P', 'T', '0', '2'};
+
+uint64_t fnv1a(const void* data, size_t bytes, uint64_t h = 1469598103934665603ull) {
+    const auto* p = static_cast<const uint8_t*>(data);
+    for (size_t i = 0; i < bytes; ++i) h = (h ^ p[i]) * 1099511628211ull;
+    return h;
+}
+
+// What a checkpoint must match to be resumed: geometry, layout and every option that changes the bytes.
+uint64_t checkpointKey(const BakeMesh& mesh, const Layout& layout, const BakeOptions& o, double historyPower) {
+    uint64_t h = fnv1a(mesh.vertices.data(), mesh.vertices.size() * sizeof(BakeVertex));
+    h = fnv1a(mesh.triangles.data(), mesh.triangles.size() * sizeof(BakeTriangle), h);
+    const int64_t ints[] = {layout.resolution, layout.pageCount, o.directions, o.bundleResolution, o.memoryBudget, int64_t(o.tiling),
+                            int64_t(o.seed), int64_t(o.rounding), o.sunJitter, o.environment ? 1 : 0};
+    h = fnv1a(ints, sizeof ints, h);
+    const double reals[] = {o.sky.r, o.sky.g, o.sky.b, historyPower};
+    h = fnv1a(reals, sizeof reals, h);
+    if (o.environment) h = fnv1a(o.environment->pixels.data(), o.environment->pixels.size() * sizeof(glm::vec3), h);
+    return h;
+}
+
+struct CheckpointHeader {
+    char magic[8];
+    uint64_t key;
+    int32_t directionsDone;
+    int32_t resolution;
+    int32_t pages;
+    int32_t pad;
+    double accumScale;
+};
+}  // namespace
+
+Status Baker::saveCheckpoint(const std::string& path) {
+    Impl& m = *impl_;
+    // a checkpoint holds whole directions: finish the one in flight (the same tiles an uninterrupted bake draws)
+    if (m.directionActive) {
+        const int k = m.stats.directionsDone;
+        while (m.stats.directionsDone == k) m.stepTile();
+    }
+    const int res = m.layout.resolution;
+    std::vector<glm::uvec2> raw(size_t(res) * res * m.layout.pageCount);
+    glGetTextureImage(m.accum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, GLsizei(raw.size() * 8), raw.data());
+    CheckpointHeader h{};
+    std::memcpy(h.magic, CHECKPOINT_MAGIC, 8);
+    h.key = checkpointKey(m.mesh, m.layout, m.options, m.historyPower);
+    h.directionsDone = m.stats.directionsDone;
+    h.resolution = res;
+    h.pages = m.layout.pageCount;
+    h.accumScale = m.accumScale;
+    // the radiance map too: it is refreshed on a schedule, so it can be older than the accumulators
+    std::vector<glm::vec4> radiance(raw.size());
+    glGetTextureImage(m.radiance.id(), 0, GL_RGBA, GL_FLOAT, GLsizei(radiance.size() * 16), radiance.data());
+    std::string bytes(reinterpret_cast<const char*>(&h), sizeof h);
+    bytes.append(reinterpret_cast<const char*>(raw.data()), raw.size() * sizeof(glm::uvec2));
+    bytes.append(reinterpret_cast<const char*>(radiance.data()), radiance.size() * sizeof(glm::vec4));
+    return io::writeFileAtomic(path, bytes);
+}
+
+Status Baker::loadCheckpoint(const std::string& path) {
+    Impl& m = *impl_;
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    if (!f) return Status::error("cannot read checkpoint " + path);
+    CheckpointHeader h{};
+    const int res = m.layout.resolution;
+    std::vector<glm::uvec2> raw(size_t(res) * res * m.layout.pageCount);
+    std::vector<glm::vec4> radiance(raw.size());
+    bool ok = std::fread(&h, sizeof h, 1, f) == 1 && std::memcmp(h.magic, CHECKPOINT_MAGIC, 8) == 0 &&
+              h.resolution == res && h.pages == m.layout.pageCount &&
+              std::fread(raw.data(), sizeof(glm::uvec2), raw.size(), f) == raw.size() &&
+              std::fread(radiance.data(), sizeof(glm::vec4), radiance.size(), f) == radiance.size();
+    std::fclose(f);
+    if (!ok) return Status::error(path + " is not a bundlebake checkpoint of this layout");
+    if (h.key != checkpointKey(m.mesh, m.layout, m.options, m.historyPower))
+        return Status::error(path + " was written for another scene or other bake options; remove it or bake without --resume");
+    if (h.directionsDone < 0 || h.directionsDone > m.options.directions)
+        return Status::error(path + ": corrupt progress count");
+    glTextureSubImage3D(m.accum.id(), 0, 0, 0, 0, res, res, m.layout.pageCount, GL_RG_INTEGER, GL_UNSIGNED_INT,
+                        raw.data());
+    glTextureSubImage3D(m.radiance.id(), 0, 0, 0, 0, res, res, m.layout.pageCount, GL_RGBA, GL_FLOAT, radiance.data());
+    m.stats.directionsDone = h.directionsDone;
+    m.accumScale = h.accumScale;
+    return Status::ok();
+}
+
+}  // namespace bb
