@@ -235,6 +235,16 @@ Status Baker::Impl::init(const Scene& scene) {
     clusters = clusterMesh(mesh);
     stats.triangles = int64_t(mesh.triangles.size());
     stats.clusters = int64_t(clusters.size());
+    // importance (supplement §1) decides each leaf's pixel size
+    {
+        auto t = Clock::now();
+        auto analyzer = ImportanceAnalyzer::create();
+        if (!analyzer) return analyzer.status();
+        auto result = (*analyzer)->analyze(mesh, layout.resolution);
+        if (!result) return result.status();
+        setClusterImportance(mesh, clusters, result->importance.importance);
+        stats.secondsImportance = secondsSince(t);
+    }
 
     // bundle pixel from the light map's texel density: sqrt(texel area / world area)
     double worldArea = 0, texelArea = 0;
@@ -290,16 +300,6 @@ Status Baker::Impl::init(const Scene& scene) {
     tilerOptions.nodeCapacity = options.predictTiles ? double(nodeCapacity) : 1e300;
     tilerOptions.cull = options.cull;
 
-    // importance (supplement §1) decides each leaf's pixel size
-    {
-        auto t = Clock::now();
-        auto analyzer = ImportanceAnalyzer::create();
-        if (!analyzer) return analyzer.status();
-        auto result = (*analyzer)->analyze(mesh, layout.resolution);
-        if (!result) return result.status();
-        setClusterImportance(clusters, result->importance.importance);
-        stats.secondsImportance = secondsSince(t);
-    }
 
     // history ramp power from the largest albedo
     if (options.historyPower >= 0) {

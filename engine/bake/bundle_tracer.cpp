@@ -71,16 +71,8 @@ void BundleTracer::ensureHeads(int side) {
 }
 
 void BundleTracer::drawClusters(const std::vector<uint32_t>& ids, bool receiversOnly) {
-    const std::vector<Cluster>& clusters = *scene_.clusters;
-    if (receiversOnly) {
-        // clusters without a texel centre have nothing to update
-        std::vector<uint32_t> receivers;
-        for (uint32_t i : ids)
-            if (clusters[i].maxImportance > 0.0f) receivers.push_back(i);
-        clusterRanges(clusters, receivers, drawFirst_, drawCount_);
-    } else {
-        clusterRanges(clusters, ids, drawFirst_, drawCount_);
-    }
+    // the update pass draws only triangles with texel centres (receivers first in each cluster)
+    clusterRanges(*scene_.clusters, ids, drawFirst_, drawCount_, receiversOnly);
     if (!drawFirst_.empty())
         glMultiDrawArrays(GL_TRIANGLES, drawFirst_.data(), drawCount_.data(), GLsizei(drawFirst_.size()));
     int64_t triangles = 0;

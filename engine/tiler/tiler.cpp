@@ -104,7 +104,7 @@ struct QuadtreeBuilder {
                 return;
             }
         }
-        leaves.push_back({min, extent, pixels});
+        leaves.push_back({min, extent, std::min(pixels, o.maxLeafPixels)});  // (past maxDepth: coarser, never past the viewport)
         leafClusters.push_back(std::move(ids));
     }
 };
@@ -175,10 +175,31 @@ std::vector<Cluster> clusterMesh(BakeMesh& mesh, uint32_t maxTriangles) {
     return clusters;
 }
 
-void setClusterImportance(std::vector<Cluster>& clusters, const std::vector<float>& importance) {
+void setClusterImportance(BakeMesh& mesh, std::vector<Cluster>& clusters, std::vector<float>& importance) {
+    CHECK_EQ(importance.size(), mesh.triangles.size());
+    std::vector<uint32_t> order;
+    std::vector<BakeTriangle> triangles;
+    std::vector<BakeVertex> vertices;
+    std::vector<float> values;
     for (Cluster& c : clusters) {
+        order.resize(c.count);
+        std::iota(order.begin(), order.end(), c.first);
+        std::stable_partition(order.begin(), order.end(), [&](uint32_t t) { return importance[t] > 0.0f; });
+        triangles.clear();
+        vertices.clear();
+        values.clear();
         c.maxImportance = 0.0f;
-        for (uint32_t t = c.first; t < c.first + c.count; ++t) c.maxImportance = std::max(c.maxImportance, importance[t]);
+        c.receivers = 0;
+        for (uint32_t t : order) {
+            triangles.push_back(mesh.triangles[t]);
+            for (int k = 0; k < 3; ++k) vertices.push_back(mesh.vertices[3 * size_t(t) + k]);
+            values.push_back(importance[t]);
+            c.maxImportance = std::max(c.maxImportance, importance[t]);
+            c.receivers += importance[t] > 0.0f;
+        }
+        std::copy(triangles.begin(), triangles.end(), mesh.triangles.begin() + c.first);
+        std::copy(vertices.begin(), vertices.end(), mesh.vertices.begin() + 3 * size_t(c.first));
+        std::copy(values.begin(), values.end(), importance.begin() + c.first);
     }
 }
 
@@ -278,16 +299,18 @@ DirectionTiling tileBundle(const std::vector<Cluster>& clusters, const std::vect
 }
 
 void clusterRanges(const std::vector<Cluster>& clusters, const std::vector<uint32_t>& tileClusters,
-                   std::vector<int32_t>& firstVertex, std::vector<int32_t>& vertexCount) {
+                   std::vector<int32_t>& firstVertex, std::vector<int32_t>& vertexCount, bool receiversOnly) {
     firstVertex.clear();
     vertexCount.clear();
     for (uint32_t i : tileClusters) {
         const Cluster& c = clusters[i];
+        const uint32_t n = receiversOnly ? c.receivers : c.count;
+        if (n == 0) continue;
         if (!firstVertex.empty() && uint32_t(firstVertex.back() + vertexCount.back()) == 3 * c.first)
-            vertexCount.back() += int32_t(3 * c.count);
+            vertexCount.back() += int32_t(3 * n);
         else {
             firstVertex.push_back(int32_t(3 * c.first));
-            vertexCount.push_back(int32_t(3 * c.count));
+            vertexCount.push_back(int32_t(3 * n));
         }
     }
 }

@@ -52,6 +52,7 @@ struct Cluster {
     uint32_t page = 0;
     glm::vec3 boundsMin{0.0f}, boundsMax{0.0f};  // world
     float maxImportance = 0.0f;                   // max I(t), texels per scene unit^2; 0 = no texel centre
+    uint32_t receivers = 0;  // [first, first + receivers) cover texel centres (I(t) > 0); the rest only occlude
 };
 
 // Reorders `mesh.triangles` (and their vertices) so each page's triangles
@@ -61,8 +62,12 @@ struct Cluster {
 // Deterministic. Cost: O(T log T).
 std::vector<Cluster> clusterMesh(BakeMesh& mesh, uint32_t maxTriangles = 256);
 
-// maxImportance of each cluster from per-triangle I(t) (BakeMesh order).
-void setClusterImportance(std::vector<Cluster>& clusters, const std::vector<float>& importance);
+// maxImportance and receivers of each cluster from per-triangle I(t)
+// (BakeMesh order), reordering each cluster's triangles (and `importance`)
+// so the receivers come first: the update pass then draws only triangles
+// with texel centres (I(t) = 0 exactly when a triangle covers none, Eq. 4).
+// Stable within both groups, so deterministic.
+void setClusterImportance(BakeMesh& mesh, std::vector<Cluster>& clusters, std::vector<float>& importance);
 
 // The bundle plane of one direction: rays travel along +dir; (u, v) are plane
 // coordinates; the root square is [origin, origin + size]^2 in (u, v).
@@ -135,8 +140,9 @@ Tile makeTile(const DirectionTiling& tiling, int leaf, const TileWindow& window,
 // The four quarters of a window (fewer when it is one pixel wide or high).
 std::vector<TileWindow> splitWindow(const TileWindow& window);
 
-// Draw ranges (first triangle, count) of `tileClusters`, adjacent clusters merged.
+// Draw ranges (first vertex, vertex count) of `tileClusters`, adjacent ranges
+// merged: every triangle, or (receiversOnly) each cluster's receivers.
 void clusterRanges(const std::vector<Cluster>& clusters, const std::vector<uint32_t>& tileClusters,
-                   std::vector<int32_t>& firstVertex, std::vector<int32_t>& vertexCount);
+                   std::vector<int32_t>& firstVertex, std::vector<int32_t>& vertexCount, bool receiversOnly = false);
 
 }  // namespace bb

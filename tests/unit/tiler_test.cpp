@@ -114,7 +114,7 @@ TEST(Tiler, LeavesFollowImportanceAndPartitionTheRoot) {
     auto clusters = clusterMesh(mesh, 16);
     std::vector<float> importance(mesh.triangles.size());
     for (size_t t = 0; t < importance.size(); ++t) importance[t] = mesh.vertices[3 * t].position.z > 1 ? 256.0f : 1.0f;
-    setClusterImportance(clusters, importance);
+    setClusterImportance(mesh, clusters, importance);
     const BundleFrame frame = downFrame(72);
     const auto views = projectClusters(mesh, clusters, frame);
     TilerOptions o;
@@ -158,7 +158,8 @@ TEST(Tiler, PredictionMatchesTheRasterAndTilesFitTheBudget) {
     addGrid(mesh, -20.0071f, -9.9913f, 3, 30, 12, 0);  // a second layer: depth complexity 2 where they overlap
     finishPages(mesh, 1);
     auto clusters = clusterMesh(mesh, 32);
-    setClusterImportance(clusters, std::vector<float>(mesh.triangles.size(), 0.09f));  // 0.3 texels per unit
+    std::vector<float> importance(mesh.triangles.size(), 0.09f);
+    setClusterImportance(mesh, clusters, importance);  // 0.3 texels per unit
     const BundleFrame frame = downFrame(60);
     const auto views = projectClusters(mesh, clusters, frame);
     TilerOptions o;
@@ -186,7 +187,7 @@ TEST(Tiler, LeavesDoNotDependOnTheBudgetButTilesDo) {
     auto clusters = clusterMesh(mesh, 32);
     std::vector<float> importance(mesh.triangles.size());
     for (size_t t = 0; t < importance.size(); ++t) importance[t] = mesh.vertices[3 * t].position.z > 1 ? 64.0f : 0.25f;
-    setClusterImportance(clusters, importance);
+    setClusterImportance(mesh, clusters, importance);
     const BundleFrame frame = downFrame(72);
     const auto views = projectClusters(mesh, clusters, frame);
     TilerOptions roomy, tight;
@@ -215,7 +216,8 @@ TEST(Tiler, CullingKeepsOnlyClustersThatMeetTheTile) {
     addGrid(mesh, -50, -50, 0, 100, 32, 0);
     finishPages(mesh, 1);
     auto clusters = clusterMesh(mesh, 16);
-    setClusterImportance(clusters, std::vector<float>(mesh.triangles.size(), 1.0f));
+    std::vector<float> importance(mesh.triangles.size(), 1.0f);
+    setClusterImportance(mesh, clusters, importance);
     const BundleFrame frame = downFrame(60);
     const auto views = projectClusters(mesh, clusters, frame);
     TilerOptions o;
