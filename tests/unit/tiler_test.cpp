@@ -105,16 +105,27 @@ double exactFragments(const BakeMesh& mesh, const BundleFrame& f, const BundleLe
     return n;
 }
 
-TEST(Tiler, LeavesFollowImportanceAndPartitionTheRoot) {
-    // a sparse 100-unit plane (1 texel per unit) with a dense 4-unit patch (16 texels per unit) above it
+// A sparse 100-unit plane (importance `sparse`, n x n quads) with a dense
+// patch of `patch` units above it at z = 2 (importance `dense`), clustered.
+struct PlaneAndPatch {
     BakeMesh mesh;
-    addGrid(mesh, -50, -50, 0, 100, 8, 0);
-    addGrid(mesh, 10, 10, 5, 4, 8, 0);
-    finishPages(mesh, 1);
-    auto clusters = clusterMesh(mesh, 16);
-    std::vector<float> importance(mesh.triangles.size());
-    for (size_t t = 0; t < importance.size(); ++t) importance[t] = mesh.vertices[3 * t].position.z > 1 ? 256.0f : 1.0f;
-    setClusterImportance(mesh, clusters, importance);
+    std::vector<Cluster> clusters;
+};
+PlaneAndPatch planeAndPatch(int n, float patch, float sparse, float dense, uint32_t clusterTriangles) {
+    PlaneAndPatch s;
+    addGrid(s.mesh, -50, -50, 0, 100, n, 0);
+    addGrid(s.mesh, 10, 10, 2, patch, 8, 0);
+    finishPages(s.mesh, 1);
+    s.clusters = clusterMesh(s.mesh, clusterTriangles);
+    std::vector<float> importance(s.mesh.triangles.size());
+    for (size_t t = 0; t < importance.size(); ++t) importance[t] = s.mesh.vertices[3 * t].position.z > 1 ? dense : sparse;
+    setClusterImportance(s.mesh, s.clusters, importance);
+    return s;
+}
+
+TEST(Tiler, LeavesFollowImportanceAndPartitionTheRoot) {
+    // 1 texel per unit on the plane, 16 on a 4-unit patch
+    auto [mesh, clusters] = planeAndPatch(8, 4, 1.0f, 256.0f, 16);
     const BundleFrame frame = downFrame(72);
     const auto views = projectClusters(mesh, clusters, frame);
     TilerOptions o;
@@ -180,14 +191,7 @@ TEST(Tiler, PredictionMatchesTheRasterAndTilesFitTheBudget) {
 }
 
 TEST(Tiler, LeavesDoNotDependOnTheBudgetButTilesDo) {
-    BakeMesh mesh;
-    addGrid(mesh, -50, -50, 0, 100, 16, 0);
-    addGrid(mesh, 0, 0, 2, 8, 8, 0);
-    finishPages(mesh, 1);
-    auto clusters = clusterMesh(mesh, 32);
-    std::vector<float> importance(mesh.triangles.size());
-    for (size_t t = 0; t < importance.size(); ++t) importance[t] = mesh.vertices[3 * t].position.z > 1 ? 64.0f : 0.25f;
-    setClusterImportance(mesh, clusters, importance);
+    auto [mesh, clusters] = planeAndPatch(16, 8, 0.25f, 64.0f, 32);
     const BundleFrame frame = downFrame(72);
     const auto views = projectClusters(mesh, clusters, frame);
     TilerOptions roomy, tight;
