@@ -391,7 +391,7 @@ Status Baker::Impl::init(const Scene& scene) {
     return Status::ok();
 }
 
-BundleFrame Baker::Impl::bundleFrame(const glm::vec3& d, glm::vec2 jitter, bool uniformGrid) const {
+BundleFrame Baker::Impl::bundleFrame(const glm::vec3& d, glm::vec2 jitter, bool uniformGrid, double jitterUnit) const {
     BundleFrame frame;
     frame.dir = d;
     orthonormalBasis(d, frame.u, frame.v);
@@ -402,16 +402,28 @@ BundleFrame Baker::Impl::bundleFrame(const glm::vec3& d, glm::vec2 jitter, bool 
         frame.size = double(gridSize) * pixelSize;
         frame.origin = centre - glm::dvec2(sphereRadius) + glm::dvec2(jitter) * double(pixelSize);
     } else {
-        // the bounding sphere's square, with a (uniform) pixel of margin for the sun's jitter
-        frame.size = 2.0 * (double(sphereRadius) + pixelSize);
-        frame.origin = centre - glm::dvec2(sphereRadius + pixelSize) + glm::dvec2(jitter) * double(pixelSize);
+        // the bounding sphere's square, with a margin for the sun's jitter
+        const double margin = std::max(double(pixelSize), jitterUnit);
+        frame.size = 2.0 * (double(sphereRadius) + margin);
+        frame.origin = centre - glm::dvec2(sphereRadius + margin) + glm::dvec2(jitter) * jitterUnit;
     }
     return frame;
 }
 
 void Baker::Impl::traceBundle(const glm::vec3& d, glm::vec2 jitter, uint32_t seed, const BundleTracer::UpdateFn& update,
                               bool recordStats) {
-    tracer->run(bundleFrame(d, jitter, tilerOptions.uniform), tilerOptions, seed, recordStats, update);
+    TilerOptions o = tilerOptions;
+    double jitterUnit = pixelSize;
+    if (!o.uniform && o.fixedPixelSize <= 0) {
+        // the sun's jittered bundles: every leaf at the scene's finest pixel, so the
+        // jitter is a stratified fraction of a pixel everywhere (a fraction of the
+        // mean texel's pixel in leaves of finer pixels bunched the samples: on
+        // mixed_lighting, 256 directions: 8.0 % against the reference, now 5.5 %)
+        float imax = 0.0f;
+        for (const Cluster& c : clusters) imax = std::max(imax, c.maxImportance);
+        if (imax > 0.0f) o.fixedPixelSize = jitterUnit = 1.0 / (o.pixelsPerTexel * std::sqrt(double(imax)));
+    }
+    tracer->run(bundleFrame(d, jitter, o.uniform, jitterUnit), o, seed, recordStats, update);
 }
 
 Baker::Baker(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -506,7 +518,7 @@ Baker::BundleCapture Baker::captureBundle(const glm::vec3& dir) {
     one.cull = false;
     one.nodeCapacity = 1e300;
     one.maxTilePixels = m.gridSize;
-    m.tracer->run(m.bundleFrame(cap.dir, glm::vec2(0.0f), true), one, 12345u, false,
+    m.tracer->run(m.bundleFrame(cap.dir, glm::vec2(0.0f), true, m.pixelSize), one, 12345u, false,
         [&](const TileFrame& f, uint32_t) -> GLuint {
             cap.u = f.u;
             cap.v = f.v;

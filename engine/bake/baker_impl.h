@@ -68,8 +68,10 @@ struct Baker::Impl {
     bool useExplicitEmitters() const;
     void bakeEmitters();
     // The root square of direction d: the uniform grid, or the adaptive root.
-    BundleFrame bundleFrame(const glm::vec3& d, glm::vec2 jitter, bool uniformGrid) const;
-    // All tiles of direction d (bundle_tracer.h), each followed by `update`.
+    // jitter: in units of jitterUnit (scene units) in adaptive roots, of the uniform pixel otherwise.
+    BundleFrame bundleFrame(const glm::vec3& d, glm::vec2 jitter, bool uniformGrid, double jitterUnit) const;
+    // All tiles of direction d (bundle_tracer.h), each followed by `update`:
+    // the sun's bundles (adaptive: at the scene's finest pixel, jittered by it).
     void traceBundle(const glm::vec3& d, glm::vec2 jitter, uint32_t seed, const BundleTracer::UpdateFn& update,
                      bool recordStats);
     // Direction k: the history ramp, then its tiles one by one, then the radiance refresh.

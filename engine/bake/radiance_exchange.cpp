@@ -46,7 +46,7 @@ void Baker::Impl::beginDirection(int k) {
         glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
         return updateProgram.id();
     };
-    tracer->begin(bundleFrame(d, glm::vec2(0.0f), tilerOptions.uniform), tilerOptions, seed, true);
+    tracer->begin(bundleFrame(d, glm::vec2(0.0f), tilerOptions.uniform, pixelSize), tilerOptions, seed, true);
     directionActive = true;
 }
 

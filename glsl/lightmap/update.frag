@@ -62,6 +62,8 @@ void main() {
     // the triangle's own plane, from screen derivatives (before any return:
     // derivatives need the whole quad)
     vec3 faceNormal = cross(dFdx(vPosition), dFdy(vPosition));
+    // this texel's size on the surface (one step of the light map raster)
+    float texelSize = max(length(dFdx(vPosition)), length(dFdy(vPosition)));
     // llvmpipe runs helper lanes through the walk with undefined loads, where they
     // spin; they have no side effects to make, so leave at once (GLSL 4.50).
     if (gl_HelperInvocation) return;
@@ -92,7 +94,10 @@ void main() {
     // backface validity does.
     vec2 offset = (g - floor(g) - 0.5) * pixelSize;  // texel minus pixel centre, scene units
     float r2 = dot(offset, offset);
-    float reach = 2.0 * pixelSize;
+    // one texel: two bundle pixels where the pixel is half a texel (the
+    // uniform grid's rule), this texel's own size where the leaf's pixel is
+    // finer (adaptive leaves take their pixel from their densest texel)
+    float reach = max(2.0 * pixelSize, texelSize);
     // where the ray meets the texel's own (triangle) plane, in depth
     float cg = dot(ng, bundleDir);
     if (abs(cg) < 1e-4) return;
