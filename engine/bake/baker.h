@@ -76,7 +76,7 @@ struct BakeStats {
     double pixelSize = 0;             // scene units (the uniform grid's; tiles: tilePixelSizes)
     double historyPower = 0;
     int64_t tilesDrawn = 0;
-    int64_t overflows = 0;            // tiles whose node count exceeded capacity and were split and redrawn
+    int64_t overflows = 0;            // tile draws whose node count exceeded the buffer: redrawn (bigger buffer, or split)
     int64_t fragments = 0;            // nodes appended (kept), over all tiles
     int64_t updatedTexels = 0;        // texel samples accumulated
     int64_t peakNodesPerTile = 0;
@@ -125,8 +125,9 @@ struct LightmapPages {
 
 class Baker {
 public:
-    // Uploads the scene, rasterizes albedo/emission into light map space and
-    // bakes the direct sun. Errors: scene too large for the GL limits, bad options.
+    // Clusters the scene's triangles and analyzes their importance (the tiler's
+    // inputs), uploads it, rasterizes albedo/emission into light map space and
+    // bakes the direct light. Errors: scene too large for the GL limits, bad options.
     static Expected<std::unique_ptr<Baker>> create(const Scene& scene, const Layout& layout, const BakeOptions& options);
     ~Baker();
 
