@@ -37,9 +37,9 @@ baker's covered_texels came out 2-6 % higher on tiny and city):
          100 k triangles, 1 064 instances, 2.0 M texels, 2.3 MB, 0.2 s
   city   5 km, 16^2 x 16^2, 10 000 buildings, 5 districts, detail 1 (the defaults):
          947 k triangles, 10 256 instances, 16.0 M texels, 16 MB, 1.2 s
-  paper  5 km, 16^2 x 32^2, 13 000 buildings, 7 districts, detail 5, densities 1.0
+  paper  5 km, 16^2 x 32^2, 13 200 buildings, 7 districts, detail 5, densities 1.0
          (terrain) and 0.8 (buildings); cf. Tokuyoshi et al. 2013's 4.9 km scene:
-         3.67 M triangles, 13 256 instances, 49.0 M texels, 59 MB, 3.3 s
+         3.73 M triangles, 13 456 instances, 48.8 M texels, 59 MB, 3.1 s
 """
 import argparse
 import array
@@ -59,7 +59,7 @@ PRESETS = {
                  footprint_m=(8.0, 16.0), height_m=(6.0, 30.0)),
     "small": dict(size_m=2000.0, terrain_tiles=8, terrain_quads=12, buildings=1000, districts=2),
     "city": dict(),
-    "paper": dict(terrain_quads=32, buildings=13000, building_detail=5, districts=7,
+    "paper": dict(terrain_quads=32, buildings=13200, building_detail=5, districts=7,
                   terrain_density=1.0, building_density=0.8),
 }
 RELIEF = 0.015          # terrain amplitude (sum of the sines' amplitudes) over its size
