@@ -29,6 +29,7 @@
 
 #include "bake/bake_output.h"
 #include "bake/baker.h"
+#include "core/timer.h"
 #include "core/log.h"
 #include "core/memory.h"
 #include "gl/gl.h"
@@ -44,8 +45,6 @@
 namespace bb::viewer {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 struct ViewerArgs {
     cli::SceneArgs scene;

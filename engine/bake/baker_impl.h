@@ -7,19 +7,16 @@
 //   checkpoint.cpp      checkpoints
 #pragma once
 
-#include <chrono>
 #include <memory>
 #include <vector>
 
 #include "bake/baker.h"
 #include "bake/bundle_tracer.h"
+#include "core/timer.h"
 #include "gl/objects.h"
 #include "tiler/tiler.h"
 
 namespace bb {
-
-using Clock = std::chrono::steady_clock;
-inline double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 struct Baker::Impl {
     BakeOptions options;

@@ -1,20 +1,16 @@
 #include "bake/bundle_tracer.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 #include "bake/rounding.h"
 #include "core/check.h"
+#include "core/timer.h"
 #include "gl/gl.h"
 #include "gl/shader.h"
 #include "glsl/shared/bundle_layout.h"
 
 namespace bb {
-namespace {
-using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-}  // namespace
 
 void setFrameUniforms(GLuint program, const TileFrame& f) {
     glUniform3fv(glGetUniformLocation(program, "bundleDir"), 1, &f.d.x);

@@ -5,6 +5,7 @@
 // with Memory Usage Prediction", CGF 32(7) 2013, supplement §1.
 #include "layout/bake_mesh_gl.h"
 #include "importance/importance_gl.h"
+#include "core/timer.h"
 
 #include <algorithm>
 #include <chrono>
@@ -20,8 +21,6 @@
 namespace bb {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // The compute pass reads BakeVertex as the std430 struct ImportanceVertex.
 static_assert(sizeof(BakeVertex) == 48);

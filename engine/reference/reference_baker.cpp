@@ -19,13 +19,12 @@
 #endif
 
 #include "core/check.h"
+#include "core/timer.h"
 #include "core/log.h"
 
 namespace bb {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 constexpr float PI = 3.14159265358979323846f;
 constexpr float INV_PI = 1.0f / PI;
