@@ -400,7 +400,7 @@ void Viewer::drawPanel() {
         else
             ImGui::Text("%.2f directions/s, ETA %s%s", directionsPerSecond_, paused_ ? "- (paused)" : duration(eta).c_str(),
                         "");
-        ImGui::Text("%.1f ms per direction, %.1f s baking", tileSeconds_ * 1e3, bakeSeconds_);
+        ImGui::Text("%.1f ms per tile, %.1f s baking", tileSeconds_ * 1e3, bakeSeconds_);
         if (ImGui::Button(paused_ ? "Resume" : "Pause")) paused_ = !paused_;
         ImGui::SameLine();
         if (ImGui::Button("Restart")) {

@@ -53,31 +53,37 @@ std::vector<int32_t> dilationSources(const std::vector<uint8_t>& covered, int re
     return source;
 }
 
-}  // namespace
+// Quantile q in [0, 1] of `values` (nearest rank below); 0 when empty.
+template <class T>
+double quantile(std::vector<T> values, double q) {
+    if (values.empty()) return 0.0;
+    std::sort(values.begin(), values.end());
+    return double(values[size_t(q * double(values.size() - 1))]);
+}
 
+template <class T>
+double mean(const std::vector<T>& values) {
+    return values.empty() ? 0.0 : std::accumulate(values.begin(), values.end(), 0.0) / double(values.size());
+}
+
+}  // namespace
 
 nlohmann::json BakeStats::toJson() const {
     nlohmann::json j;
     j["directions"] = {{"done", directionsDone}, {"total", directionsTotal}};
     j["bundle"] = {{"resolution_pixels", bundleResolution}, {"pixel_size_scene_units", pixelSize},
                    {"history_power", historyPower}};
-    auto sorted = predictedOverActual;
-    std::sort(sorted.begin(), sorted.end());
-    auto pct = [&](double q) { return sorted.empty() ? 0.0 : sorted[size_t(q * (sorted.size() - 1))]; };
+    auto pct = [&](double q) { return quantile(predictedOverActual, q); };
+    auto size = [&](double q) { return quantile(tilePixelSizes, q); };
     int maxTiles = tilesPerDirection.empty() ? 0 : *std::max_element(tilesPerDirection.begin(), tilesPerDirection.end());
-    double meanTiles = tilesPerDirection.empty() ? 0.0
-        : std::accumulate(tilesPerDirection.begin(), tilesPerDirection.end(), 0.0) / tilesPerDirection.size();
-    auto sizes = tilePixelSizes;
-    std::sort(sizes.begin(), sizes.end());
-    auto size = [&](double q) { return sizes.empty() ? 0.0 : double(sizes[size_t(q * (sizes.size() - 1))]); };
-    double meanLeaves = leavesPerDirection.empty() ? 0.0
-        : std::accumulate(leavesPerDirection.begin(), leavesPerDirection.end(), 0.0) / leavesPerDirection.size();
+    double meanTiles = mean(tilesPerDirection);
+    double meanLeaves = mean(leavesPerDirection);
     const double drawnTiles = double(std::max<int64_t>(tilesDrawn, 1)) * double(std::max<int64_t>(triangles, 1));
     j["tiles"] = {{"drawn", tilesDrawn}, {"per_direction_mean", meanTiles}, {"per_direction_max", maxTiles},
                   {"leaves_per_direction_mean", meanLeaves},
                   {"overflows_redrawn", overflows},
                   {"predicted_over_actual_nodes", {{"min", pct(0)}, {"p10", pct(0.1)}, {"median", pct(0.5)},
-                                                   {"p90", pct(0.9)}, {"max", pct(1)}, {"count", sorted.size()}}},
+                                                   {"p90", pct(0.9)}, {"max", pct(1)}, {"count", predictedOverActual.size()}}},
                   {"pixel_size_scene_units", {{"min", size(0)}, {"median", size(0.5)}, {"max", size(1)}}}};
     j["culling"] = {{"clusters", clusters}, {"triangles", triangles},
                     {"bundle_pass_triangles_drawn_fraction", double(bundleTrianglesDrawn) / drawnTiles},
@@ -299,7 +305,13 @@ Status Baker::Impl::init(const Scene& scene) {
     tilerOptions.maxTilePixels = maxTileSize;
     tilerOptions.nodeCapacity = options.predictTiles ? double(nodeCapacity) : 1e300;
     tilerOptions.cull = options.cull;
-
+    // the sun's bundles in adaptive mode: every leaf at the scene's finest pixel
+    // (bakeSun), so the jitter is a stratified fraction of a pixel everywhere
+    if (!tilerOptions.uniform && tilerOptions.fixedPixelSize <= 0) {
+        float imax = 0.0f;
+        for (const Cluster& c : clusters) imax = std::max(imax, c.maxImportance);
+        if (imax > 0.0f) sunPixelSize = pixelForImportance(imax, tilerOptions.pixelsPerTexel);
+    }
 
     // history ramp power from the largest albedo
     if (options.historyPower >= 0) {
@@ -410,22 +422,6 @@ BundleFrame Baker::Impl::bundleFrame(const glm::vec3& d, glm::vec2 jitter, bool 
     return frame;
 }
 
-void Baker::Impl::traceBundle(const glm::vec3& d, glm::vec2 jitter, uint32_t seed, const BundleTracer::UpdateFn& update,
-                              bool recordStats) {
-    TilerOptions o = tilerOptions;
-    double jitterUnit = pixelSize;
-    if (!o.uniform && o.fixedPixelSize <= 0) {
-        // the sun's jittered bundles: every leaf at the scene's finest pixel, so the
-        // jitter is a stratified fraction of a pixel everywhere (a fraction of the
-        // mean texel's pixel in leaves of finer pixels bunched the samples: on
-        // mixed_lighting, 256 directions: 8.0 % against the reference, now 5.5 %)
-        float imax = 0.0f;
-        for (const Cluster& c : clusters) imax = std::max(imax, c.maxImportance);
-        if (imax > 0.0f) o.fixedPixelSize = jitterUnit = 1.0 / (o.pixelsPerTexel * std::sqrt(double(imax)));
-    }
-    tracer->run(bundleFrame(d, jitter, o.uniform, jitterUnit), o, seed, recordStats, update);
-}
-
 Baker::Baker(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 Baker::~Baker() = default;
 
@@ -440,24 +436,30 @@ Expected<std::unique_ptr<Baker>> Baker::create(const Scene& scene, const Layout&
     return std::unique_ptr<Baker>(new Baker(std::move(impl)));
 }
 
-BakeProgress Baker::step(double seconds) {
+void Baker::Impl::stepDirection() {
+    const int k = stats.directionsDone;
+    while (stats.directionsDone == k) stepTile();
+}
+
+void Baker::Impl::run(double seconds, bool wholeDirections) {
     auto t0 = Clock::now();
-    while (impl_->stats.directionsDone < impl_->options.directions) {
-        const int k = impl_->stats.directionsDone;
-        while (impl_->stats.directionsDone == k) impl_->stepTile();
+    while (stats.directionsDone < options.directions) {
+        if (wholeDirections)
+            stepDirection();
+        else
+            stepTile();
         if (secondsSince(t0) >= seconds) break;
     }
-    impl_->stats.peakGpuBytes = MemoryTracker::gpu().peak();
+    stats.peakGpuBytes = MemoryTracker::gpu().peak();
+}
+
+BakeProgress Baker::step(double seconds) {
+    impl_->run(seconds, true);
     return progress();
 }
 
 BakeProgress Baker::stepTiles(double seconds) {
-    auto t0 = Clock::now();
-    while (impl_->stats.directionsDone < impl_->options.directions) {
-        impl_->stepTile();
-        if (secondsSince(t0) >= seconds) break;
-    }
-    impl_->stats.peakGpuBytes = MemoryTracker::gpu().peak();
+    impl_->run(seconds, false);
     return progress();
 }
 

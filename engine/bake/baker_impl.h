@@ -31,6 +31,7 @@ struct Baker::Impl {
     glm::vec3 sphereCenter{0.0f};
     float sphereRadius = 1.0f;
     float pixelSize = 1.0f;
+    double sunPixelSize = 0;  // adaptive: the scene's finest pixel, for the sun's jittered bundles (0: pixelSize)
     int gridSize = 1;         // pixels across the uniform bundle (--tiling uniform, captures)
     int maxTileSize = 2048;   // largest head image side the budget allows
     float depthBias = 0.0f;
@@ -67,13 +68,12 @@ struct Baker::Impl {
     // The root square of direction d: the uniform grid, or the adaptive root.
     // jitter: in units of jitterUnit (scene units) in adaptive roots, of the uniform pixel otherwise.
     BundleFrame bundleFrame(const glm::vec3& d, glm::vec2 jitter, bool uniformGrid, double jitterUnit) const;
-    // All tiles of direction d (bundle_tracer.h), each followed by `update`:
-    // the sun's bundles (adaptive: at the scene's finest pixel, jittered by it).
-    void traceBundle(const glm::vec3& d, glm::vec2 jitter, uint32_t seed, const BundleTracer::UpdateFn& update,
-                     bool recordStats);
     // Direction k: the history ramp, then its tiles one by one, then the radiance refresh.
     void beginDirection(int k);
     void stepTile();
+    void stepDirection();  // tiles until the direction in flight (or the next) is done
+    // Baker::step (whole directions) and stepTiles: until `seconds` have passed, at least one step.
+    void run(double seconds, bool wholeDirections);
     void finishDirection(int k);
     void resolveInto(bool radianceOut, gl::Texture& target);
     void dispatchPages(GLuint program);

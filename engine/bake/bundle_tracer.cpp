@@ -118,6 +118,11 @@ void BundleTracer::next(const UpdateFn& update) {
     if (limits_.predict) ensureNodes(int64_t(std::ceil(1.25 * tile.predictedNodes)) + 1024);
     ensureHeads(std::max(tile.window.width, tile.window.height));
 
+    // what both passes read
+    glBindVertexArray(scene_.vertexArray);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, scene_.triangleBuffer);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_NODES, nodes_.id());
+
     auto tb = Clock::now();
     {
         gl::DebugGroup group("bundle pass");
@@ -139,9 +144,6 @@ void BundleTracer::next(const UpdateFn& update) {
         glViewport(-tile.window.x, -tile.window.y, viewportPixels, viewportPixels);
         glEnable(GL_SCISSOR_TEST);
         glScissor(0, 0, tile.window.width, tile.window.height);
-        glBindVertexArray(scene_.vertexArray);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, scene_.triangleBuffer);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_NODES, nodes_.id());
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_VERTICES, scene_.vertexBuffer);
         glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, BINDING_NODE_COUNTER, counter_.id());
         glBindImageTexture(BINDING_HEADS, heads_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
@@ -188,10 +190,7 @@ void BundleTracer::next(const UpdateFn& update) {
         if (GLuint program = update(f, count)) {
             setFrameUniforms(program, f);
             glUniform1ui(glGetUniformLocation(program, "nodeCount"), count);
-            glBindVertexArray(scene_.vertexArray);
-            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, scene_.triangleBuffer);
             glBindImageTexture(BINDING_HEADS, heads_.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
-            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_NODES, nodes_.id());
             drawClusters(tile.clusters, true);
             glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
         }

@@ -52,10 +52,7 @@ struct CheckpointHeader {
 Status Baker::saveCheckpoint(const std::string& path) {
     Impl& m = *impl_;
     // a checkpoint holds whole directions: finish the one in flight (the same tiles an uninterrupted bake draws)
-    if (m.directionActive) {
-        const int k = m.stats.directionsDone;
-        while (m.stats.directionsDone == k) m.stepTile();
-    }
+    if (m.directionActive) m.stepDirection();
     const int res = m.layout.resolution;
     std::vector<glm::uvec2> raw(size_t(res) * res * m.layout.pageCount);
     glGetTextureImage(m.accum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, GLsizei(raw.size() * 8), raw.data());

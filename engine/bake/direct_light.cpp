@@ -17,21 +17,26 @@ namespace bb {
 void Baker::Impl::bakeSun() {
     if (lights.empty()) return;
     int j = std::max(1, options.sunJitter);
+    // Adaptive: the sun at the scene's finest pixel, jittered by it (a fraction
+    // of the mean texel's pixel in leaves of finer pixels bunched the samples:
+    // on mixed_lighting, 256 directions: 8.0 % against the reference, now 5.5 %)
+    TilerOptions sunOptions = tilerOptions;
+    if (sunPixelSize > 0) sunOptions.fixedPixelSize = sunPixelSize;
+    const double jitterUnit = sunPixelSize > 0 ? sunPixelSize : pixelSize;
     for (size_t li = 0; li < lights.size(); ++li) {
-        const auto& light = lights[li];
-        glm::vec3 irradiance = light.irradiance;
+        const glm::vec3 irradiance = lights[li].irradiance;
+        const BundleTracer::UpdateFn update = [&](const TileFrame&, uint32_t) -> GLuint {
+            glUseProgram(sunProgram.id());
+            glUniform3fv(sunProgram.uniform("sunIrradiance"), 1, &irradiance.x);
+            glUniform1f(sunProgram.uniform("depthBias"), depthBias);
+            glBindImageTexture(BINDING_SUN, sunMap.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
+            return sunProgram.id();
+        };
         for (int jy = 0; jy < j; ++jy)
             for (int jx = 0; jx < j; ++jx) {
-                glm::vec2 jitter((jx + 0.5f) / j - 0.5f, (jy + 0.5f) / j - 0.5f);
-                traceBundle(glm::normalize(light.direction), jitter, uint32_t(li * 1000 + jy * j + jx),
-                    [&](const TileFrame&, uint32_t) -> GLuint {
-                        glUseProgram(sunProgram.id());
-                        glUniform3fv(sunProgram.uniform("sunIrradiance"), 1, &irradiance.x);
-                        glUniform1f(sunProgram.uniform("depthBias"), depthBias);
-                        glBindImageTexture(BINDING_SUN, sunMap.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
-                        return sunProgram.id();
-                    },
-                    false);
+                const glm::vec2 jitter((jx + 0.5f) / j - 0.5f, (jy + 0.5f) / j - 0.5f);
+                tracer->run(bundleFrame(glm::normalize(lights[li].direction), jitter, sunOptions.uniform, jitterUnit),
+                            sunOptions, uint32_t(li * 1000 + jy * j + jx), false, update);
             }
     }
 }

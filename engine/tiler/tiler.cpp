@@ -66,7 +66,7 @@ struct QuadtreeBuilder {
     // Pixels across a node of `extent` whose largest importance is `imax`.
     int pixelsFor(double extent, float imax) const {
         double side = extent * rootSize;
-        double p = o.fixedPixelSize > 0 ? o.fixedPixelSize : 1.0 / (o.pixelsPerTexel * std::sqrt(double(imax)));
+        double p = o.fixedPixelSize > 0 ? o.fixedPixelSize : pixelForImportance(imax, o.pixelsPerTexel);
         return int(std::max(1.0, std::ceil(side / p - 1e-9)));
     }
 
@@ -74,6 +74,11 @@ struct QuadtreeBuilder {
         float m = 0;
         for (uint32_t i : ids) m = std::max(m, clusters[i].maxImportance);
         return m;
+    }
+
+    // Quarter k (x = k & 1, y = k >> 1) of the node at `min` of side `extent`.
+    static glm::dvec2 quarterMin(glm::dvec2 min, double extent, int k) {
+        return min + glm::dvec2((k & 1) * 0.5 * extent, (k >> 1) * 0.5 * extent);
     }
 
     void build(glm::dvec2 min, double extent, int depth, const std::vector<uint32_t>& candidates) {
@@ -87,10 +92,11 @@ struct QuadtreeBuilder {
             if (!split && o.fixedPixelSize <= 0 && pixels >= 64) {
                 // split where the quarters need coarser pixels and that saves a third of the fragments
                 const double here = predict(views, ids, s, extent / pixels, rootSize);
+                const double h = 0.5 * extent;
                 double quarters = 0;
                 for (int k = 0; k < 4; ++k) {
-                    const double h = 0.5 * extent;
-                    Square q{min.x + (k & 1) * h, min.y + (k >> 1) * h, min.x + (k & 1) * h + h, min.y + (k >> 1) * h + h};
+                    const glm::dvec2 m = quarterMin(min, extent, k);
+                    const Square q{m.x, m.y, m.x + h, m.y + h};
                     std::vector<uint32_t> sub = filter(views, ids, q);
                     float qmax = maxImportance(sub);
                     if (qmax > 0) quarters += predict(views, sub, q, h / pixelsFor(h, qmax), rootSize);
@@ -98,9 +104,7 @@ struct QuadtreeBuilder {
                 split = quarters < (2.0 / 3.0) * here;
             }
             if (split) {
-                const double h = 0.5 * extent;
-                for (int k = 0; k < 4; ++k)
-                    build(min + glm::dvec2((k & 1) * h, (k >> 1) * h), h, depth + 1, ids);
+                for (int k = 0; k < 4; ++k) build(quarterMin(min, extent, k), 0.5 * extent, depth + 1, ids);
                 return;
             }
         }
@@ -110,6 +114,10 @@ struct QuadtreeBuilder {
 };
 
 }  // namespace
+
+double pixelForImportance(float importance, double pixelsPerTexel) {
+    return 1.0 / (pixelsPerTexel * std::sqrt(double(importance)));
+}
 
 std::vector<Cluster> clusterMesh(BakeMesh& mesh, uint32_t maxTriangles) {
     CHECK_GE(maxTriangles, 1u);

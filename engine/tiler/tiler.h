@@ -120,6 +120,10 @@ struct TilerOptions {
     bool cull = true;            // false: every tile draws every cluster (culling on/off tests)
 };
 
+// The bundle pixel (scene units) that texels of importance I (texels per
+// scene unit^2) need: 1 / (pixelsPerTexel sqrt(I)). Precondition: I > 0.
+double pixelForImportance(float importance, double pixelsPerTexel);
+
 struct DirectionTiling {
     std::vector<BundleLeaf> leaves;
     std::vector<Tile> tiles;      // drawing order; leaves with no texel to update have none
