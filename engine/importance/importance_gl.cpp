@@ -22,7 +22,7 @@ namespace bb {
 namespace {
 
 
-// The compute pass reads BakeVertex as the std430 struct ImportanceVertex.
+// The compute pass reads BakeVertex as the std430 struct of glsl/shared/mesh_layout.h.
 static_assert(sizeof(BakeVertex) == 48);
 static_assert(offsetof(BakeVertex, position) == 0);
 static_assert(offsetof(BakeVertex, lightmapUv) == 40);

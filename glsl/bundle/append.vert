@@ -7,14 +7,8 @@
 uniform int viewportPixels;   // the viewport's side: a power of two >= leafPixels
 uniform float subpixelSteps;  // 2^GL_SUBPIXEL_BITS
 
-// The whole triangle, for the plane equations below (BakeVertex, 48 bytes).
-struct Vertex {
-    vec4 position;
-    vec4 normal;
-    vec2 uv0;
-    vec2 lightmapUv;
-};
-layout(std430, binding = BINDING_VERTICES) readonly buffer Vertices { Vertex vertices[]; };
+// The whole triangle, for the plane equations below.
+layout(std430, binding = BINDING_VERTICES) readonly buffer Vertices { BakeVertex vertices[]; };
 
 // Depth and light map uv as planes over the leaf's pixel grid: value =
 // dot(plane.xy, pixel centre) + plane.z. Every vertex of a triangle computes

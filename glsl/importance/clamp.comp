@@ -10,7 +10,7 @@
 
 layout(local_size_x = IMPORTANCE_GROUP_SIZE) in;
 
-layout(std430, binding = IMPORTANCE_BINDING_VERTICES) readonly buffer Vertices { ImportanceVertex vertices[]; };
+layout(std430, binding = IMPORTANCE_BINDING_VERTICES) readonly buffer Vertices { BakeVertex vertices[]; };
 layout(std430, binding = IMPORTANCE_BINDING_MAX_DENSITY) readonly buffer MaxDensity { uint maxDensityBits[]; };
 layout(std430, binding = IMPORTANCE_BINDING_IMPORTANCE) writeonly buffer Importance { float importance[]; };
 layout(std430, binding = IMPORTANCE_BINDING_AREA_RATIO) writeonly buffer AreaRatio { float areaRatio[]; };

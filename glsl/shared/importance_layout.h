@@ -2,22 +2,16 @@
 // glsl/importance/*), shared by C++ and GLSL. Per-triangle buffers are tight
 // arrays of 4-byte values indexed like BakeMesh::triangles; the vertex buffer
 // is BakeVertex (engine/layout/bake_mesh.h, 48 bytes), read by the compute
-// pass as the std430 struct ImportanceVertex below.
+// pass as the std430 struct of shared/mesh_layout.h.
 #ifndef BUNDLEBAKE_IMPORTANCE_LAYOUT_H
 #define BUNDLEBAKE_IMPORTANCE_LAYOUT_H
 
 #ifndef __cplusplus
-// BakeVertex as std430 sees it: 48 bytes, offsets 0, 16, 32, 40.
-struct ImportanceVertex {
-    vec4 position;    // xyz world position, w = 1
-    vec4 normal;      // unused here
-    vec2 uv0;         // unused here
-    vec2 lightmapUv;  // page-space light map coordinates
-};
+#include "shared/mesh_layout.h"
 #endif
 
 // SSBOs (1 is lib/bake_vertex.glsl's Triangles, declared by the shared vertex shader)
-#define IMPORTANCE_BINDING_VERTICES 0     // ImportanceVertex vertices[] (3 per triangle; compute pass)
+#define IMPORTANCE_BINDING_VERTICES 0     // BakeVertex vertices[] (3 per triangle; compute pass)
 #define IMPORTANCE_BINDING_MAX_DENSITY 2  // uint maxDensityBits[]: floatBitsToUint(I_max(t)), 0 = none
 #define IMPORTANCE_BINDING_IMPORTANCE 3   // float importance[]: I(t), Eq. (4)
 #define IMPORTANCE_BINDING_AREA_RATIO 4   // float areaRatio[]: A_l/A_o, Eq. (1)

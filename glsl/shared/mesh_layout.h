@@ -1,6 +1,18 @@
-// Per-triangle flags of BakeTriangle (engine/layout/bake_mesh.h), shared with GLSL.
+// Per-triangle flags of BakeTriangle (engine/layout/bake_mesh.h), shared with
+// GLSL, and BakeVertex as shaders read the vertex buffer through an SSBO.
 #ifndef BUNDLEBAKE_MESH_LAYOUT_H
 #define BUNDLEBAKE_MESH_LAYOUT_H
 #define TRIANGLE_DOUBLE_SIDED 1u
 #define TRIANGLE_EMISSIVE 2u
+
+#ifndef __cplusplus
+// BakeVertex as std430 sees it: 48 bytes, offsets 0, 16, 32, 40 (the C++
+// struct static_asserts its size in engine/layout/bake_mesh.h).
+struct BakeVertex {
+    vec4 position;    // xyz world position, w = 1
+    vec4 normal;      // xyz world unit normal, w = 0
+    vec2 uv0;         // material texture coordinates
+    vec2 lightmapUv;  // page-space light map coordinates
+};
+#endif
 #endif
