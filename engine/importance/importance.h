@@ -11,11 +11,13 @@
 // bundle pixel a triangle needs is 1/sqrt(I) scene units wide (DESIGN.md
 // step 3). A_o is the triangle's area in *world* space (instance transforms
 // applied), A_l its area in texels^2 of its page, and the positions of the
-// position buffer are world positions. The supplement says "object space",
+// position buffer are BakeMesh positions: world positions minus the scene's
+// local origin (BakeMesh::origin), a translation, so areas and densities are
+// the world ones. The supplement says "object space",
 // but its objects are placed at world scale; a scaled instance must get a
 // density per world area, because the bundle is a world-space grid: with
 // object-space positions a mesh instanced at scale 10 would claim 100x the
-// density it has. (BakeMesh already holds world positions.)
+// density it has. (BakeMesh already holds world-scale local positions.)
 //
 // GL-free: plain spans and structs. The texel conventions are those of the
 // light map pages: texel (x, y) has its centre at page uv ((x+0.5)/R,
@@ -36,7 +38,7 @@ namespace bb {
 
 // One texel of the position buffer (pass 1 of the GL implementation).
 struct PositionTexel {
-    glm::vec3 position{0.0f};  // world position of the surface at the texel centre
+    glm::vec3 position{0.0f};  // local position (world - BakeMesh::origin) of the surface at the texel centre
     uint32_t triangle = 0;     // BakeMesh triangle index + 1 of the surface drawn there; 0 = not mapped (w = 0)
 };
 

@@ -2,7 +2,7 @@
 // raster passes in light map space and one compute pass.
 //
 //   pass 1  position buffer: every triangle of a page drawn in light map space
-//           (page uv * 2 - 1, as the light maps), writing world position
+//           (page uv * 2 - 1, as the light maps), writing local position
 //           (rgba32f) and triangle index + 1 (r32ui) per texel;
 //   pass 2  the same triangles again: per covered texel, Eq. (3) from the four
 //           neighbours in the position buffer, I_max(t) by atomicMax;
@@ -10,7 +10,7 @@
 //   pass 3  compute, per triangle: I(t) = min(A_l/A_o, I_max(t)), Eq. (4).
 //
 // Units and conventions are those of importance.h (texels per world area,
-// world positions, finite results). The CPU reference in importance.h is
+// local positions: world - BakeMesh::origin, finite results). The CPU reference in importance.h is
 // checked against this class in tests/gl/importance_test.cpp.
 //
 // Requires a current GL 4.3+ context for create(), analyze() and the

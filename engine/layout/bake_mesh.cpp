@@ -1,9 +1,12 @@
-// The scene flattened into world space with page-space light map UVs.
+// The scene flattened into local space (world - Scene::origin) with page-space
+// light map UVs.
 //
 // Based on: DESIGN.md "Data flow" steps 2 and 6-7 (one vertex array for every
-// pass). Normals go through the inverse transpose of the linear part of
-// worldFromObject; mirroring transforms (det < 0) swap two vertices so that
-// counter-clockwise stays the front face.
+// pass). Positions go through the exact (double) worldFromObject and lose the
+// origin in double, so only local coordinates are rounded to float. Normals go
+// through the inverse transpose of the linear part of worldFromObject;
+// mirroring transforms (det < 0) swap two vertices so that counter-clockwise
+// stays the front face.
 #include "layout/bake_mesh.h"
 
 #include <cmath>
@@ -45,8 +48,10 @@ BakeMesh buildBakeMesh(const Scene& scene, const Layout& layout) {
     for (size_t i = 0; i < scene.instances.size(); ++i) {
         const Instance& inst = scene.instances[i];
         const InstanceRect& rect = layout.rects[i];
-        const glm::mat4& worldFromObject = inst.worldFromObject;
-        const glm::mat3 linear(worldFromObject);
+        // translation minus the origin in double: exact for a node translation
+        glm::dmat4 localFromObject = inst.exactWorldFromObject();
+        localFromObject[3] -= glm::dvec4(scene.origin, 0.0);
+        const glm::mat3 linear(inst.worldFromObject);
         const glm::mat3 normalFromObject = glm::transpose(glm::inverse(linear));
         const bool mirrored = glm::determinant(linear) < 0.0f;
         // vertex order that keeps front faces front (swap 1 and 2 when mirrored)
@@ -71,9 +76,9 @@ BakeMesh buildBakeMesh(const Scene& scene, const Layout& layout) {
                 for (int k = 0; k < 3; ++k) {
                     const uint32_t index = prim.indices[3 * t + size_t(order[k])];
                     DCHECK(index < prim.positions.size());
-                    const glm::vec3 world = glm::vec3(worldFromObject * glm::vec4(prim.positions[index], 1.0f));
-                    v[k].position = glm::vec4(world, 1.0f);
-                    out.bounds.extend(world);
+                    const glm::vec3 local(localFromObject * glm::dvec4(glm::dvec3(prim.positions[index]), 1.0));
+                    v[k].position = glm::vec4(local, 1.0f);
+                    out.bounds.extend(local);
                     v[k].uv0 = hasUv0 ? prim.uv0[index] : glm::vec2(0.0f);
                     v[k].lightmapUv = prim.uv1[index] * rect.scale + rect.offset;
                     v[k].normal = glm::vec4(0.0f);
@@ -95,6 +100,7 @@ BakeMesh buildBakeMesh(const Scene& scene, const Layout& layout) {
         }
     }
     out.pageFirstTriangle = std::move(first);
+    out.origin = scene.origin;
     return out;
 }
 

@@ -1,6 +1,7 @@
-// The scene flattened for baking: every instance's triangles in world space,
-// with light map coordinates already in page space. One vertex array for all
-// GL passes (bundle, update, importance, viewer) and the CPU reference.
+// The scene flattened for baking: every instance's triangles in local space
+// (world - Scene::origin, see scene.h), with light map coordinates already in
+// page space. One vertex array for all GL passes (bundle, update, importance,
+// viewer) and the CPU reference, which all work in this local space.
 //
 // GL-free. Vertex layout is std430-friendly (no vec3 members): it is uploaded
 // as-is into a vertex buffer.
@@ -18,7 +19,7 @@
 namespace bb {
 
 struct BakeVertex {
-    glm::vec4 position;   // xyz world position, w = 1
+    glm::vec4 position;   // xyz local position (world - BakeMesh::origin), w = 1
     glm::vec4 normal;     // xyz world unit normal (shading), w = 0
     glm::vec2 uv0;        // material texture coordinates (TEXCOORD_0, 0 if absent)
     glm::vec2 lightmapUv; // page-space light map coordinates in [0,1]^2
@@ -38,13 +39,19 @@ struct BakeMesh {
     std::vector<BakeVertex> vertices;     // 3 per triangle, not shared (simple, and normals may differ)
     std::vector<BakeTriangle> triangles;
     std::vector<uint32_t> pageFirstTriangle;  // triangles are sorted by page; page p is [first[p], first[p+1])
-    Bounds bounds;
+    Bounds bounds;            // of the positions (local space)
+    glm::dvec3 origin{0.0};   // Scene::origin: world = position + origin (directions are the same in both)
     size_t triangleCount() const { return triangles.size(); }
 };
 
-// Transforms every instance into world space (normals by the inverse
-// transpose), maps TEXCOORD_1 through the instance's rectangle, sorts
-// triangles by page. Precondition: layout was computed for this scene.
+// Transforms every instance into local space in double (the exact world
+// transform, then minus Scene::origin) before rounding positions to float;
+// normals go by the inverse transpose of the float linear part. Maps
+// TEXCOORD_1 through the instance's rectangle, sorts triangles by page.
+// A scene translated by a node translation T (T + position exact in double)
+// gives the same bytes as the untranslated one whenever T moves the origin by
+// T too (chooseLocalOrigin away from the world origin).
+// Precondition: layout was computed for this scene.
 BakeMesh buildBakeMesh(const Scene& scene, const Layout& layout);
 
 }  // namespace bb

@@ -45,6 +45,10 @@
 // after `rouletteDepth` bounces. Sample i of texel t depends only on (seed, page,
 // t, i): results are the same bits for any thread count and any pass split.
 //
+// Space: the BakeMesh's local space (world - Scene::origin, layout/bake_mesh.h),
+// so ray offsets scale with the scene's size, not its distance from the world
+// origin; suns and the sky are directions, the same in both spaces.
+//
 // Thread-safe: no. One ReferenceBaker is driven from one thread; it runs its
 // own worker threads inside step().
 #pragma once
@@ -118,6 +122,7 @@ public:
     LightmapPages readLightmaps() const;
 
     // The texel estimator at an arbitrary surface point (tests): L_lm at `point`
+    // (local space, as mesh() positions: world - BakeMesh::origin)
     // on the side `normal` faces, from `spp` samples of stream `stream`
     // (single-threaded). `normal` is used as both shading and geometric normal.
     glm::vec3 estimate(const glm::vec3& point, const glm::vec3& normal, int spp, uint64_t stream) const;

@@ -99,6 +99,13 @@ RenderView viewFromCamera(const Camera& camera, float aspect, const Bounds& boun
     return view;
 }
 
+Camera cameraInLocalSpace(const Camera& camera, const glm::dvec3& origin) {
+    Camera local = camera;
+    const glm::dvec3 eye = glm::dvec3(camera.worldFromCamera[3]) - origin;
+    local.worldFromCamera[3] = glm::vec4(glm::vec3(eye), camera.worldFromCamera[3].w);
+    return local;
+}
+
 Camera framingCamera(const Bounds& bounds, const glm::vec3& forwardIn, float yfov, float aspect) {
     const glm::vec3 center = bounds.empty() ? glm::vec3(0.0f) : bounds.center();
     const float radius = std::max(0.5f * glm::length(bounds.size()), 1e-4f);

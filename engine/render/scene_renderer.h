@@ -43,7 +43,11 @@ inline constexpr int VIEW_MODE_COUNT = 5;
 const char* viewModeName(ViewMode mode);  // "lit", "lightmap", "albedo", "importance", "density"
 Expected<ViewMode> parseViewMode(const std::string& name);
 
-// Camera matrices: right-handed world, GL clip space.
+// Camera matrices: right-handed, GL clip space. Views and cameras passed to
+// viewFromCamera and draw are in the bake mesh's local space (world -
+// BakeMesh::origin, layout/bake_mesh.h), like framingCamera(mesh.bounds);
+// a glTF camera (Scene::cameras, world space) goes through
+// cameraInLocalSpace first.
 struct RenderView {
     glm::mat4 viewFromWorld{1.0f};
     glm::mat4 clipFromView{1.0f};
@@ -56,6 +60,11 @@ struct RenderView {
 // replaced by the distance to the far side of `bounds`, for depth precision.
 // Scale in worldFromCamera is ignored.
 RenderView viewFromCamera(const Camera& camera, float aspect, const Bounds& bounds);
+
+// A world-space camera (Scene::cameras) moved into the local space of a bake
+// mesh with `origin` (BakeMesh::origin): the eye minus the origin, in double.
+// The identity for origin 0 (scenes near the world origin).
+Camera cameraInLocalSpace(const Camera& camera, const glm::dvec3& origin);
 
 // A perspective camera looking along `forward` at the centre of `bounds`,
 // far enough that the bounding sphere fits both fields of view.
@@ -95,7 +104,7 @@ struct RenderSettings {
 
 class SceneRenderer {
 public:
-    // Uploads the mesh (world-space vertices) and the scene's material textures
+    // Uploads the mesh (local-space vertices, see RenderView) and the scene's material textures
     // (sRGB8, mipmapped). `mesh` must be buildBakeMesh(scene, layout) for the
     // layout whose pages of `lightmapResolution` texels will be shown.
     // Errors: shader build failures.

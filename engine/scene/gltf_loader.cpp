@@ -858,7 +858,7 @@ Status SceneBuilder::visitNode(int nodeIndex, const glm::dmat4& worldFromNode, f
             inst.name = node.name.empty() ? "node " + std::to_string(nodeIndex) : node.name;
             inst.mesh = mesh;
             inst.node = nodeIndex;
-            inst.worldFromObject = glm::mat4(worldFromNode);
+            inst.setWorldFromObject(worldFromNode);
             inst.texelDensity = texelDensity;
             scene_.instances.push_back(std::move(inst));
         }
@@ -1007,10 +1007,22 @@ Status SceneBuilder::build() {
         logWarning(scene_.path + ": " + std::to_string(badNormals_) +
                    " zero or non-finite normal(s) replaced by face normals");
 
-    // world bounds over every instanced vertex
-    for (const Instance& inst : scene_.instances)
+    // world bounds over every instanced vertex, in double; the local origin from them
+    glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+    for (const Instance& inst : scene_.instances) {
+        const glm::dmat4& worldFromObject = inst.worldFromObjectDouble;
         for (const Primitive& p : scene_.meshes[size_t(inst.mesh)].primitives)
-            for (const glm::vec3& v : p.positions) scene_.bounds.extend(glm::vec3(inst.worldFromObject * glm::vec4(v, 1.0f)));
+            for (const glm::vec3& v : p.positions) {
+                const glm::dvec3 w(worldFromObject * glm::dvec4(glm::dvec3(v), 1.0));
+                lo = glm::min(lo, w);
+                hi = glm::max(hi, w);
+            }
+    }
+    if (lo.x <= hi.x) {
+        scene_.bounds.extend(glm::vec3(lo));
+        scene_.bounds.extend(glm::vec3(hi));
+    }
+    scene_.origin = chooseLocalOrigin(lo, hi);
 
     if (scene_.triangleCount() == 0)
         return Status::error("nothing to bake: the scene has no triangles (" + std::to_string(r.skippedNonTrianglePrimitives) +

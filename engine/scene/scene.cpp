@@ -33,7 +33,7 @@ double Scene::instanceArea(size_t instance) const {
     CHECK_LT(instance, instances.size());
     const Instance& inst = instances[instance];
     // area in double: world positions of large levels lose precision in float
-    const glm::dmat4 worldFromObject(inst.worldFromObject);
+    const glm::dmat4 worldFromObject = inst.exactWorldFromObject();
     double area2 = 0.0;  // twice the area
     for (const Primitive& p : meshes[size_t(inst.mesh)].primitives) {
         for (size_t t = 0; t + 2 < p.indices.size(); t += 3) {
@@ -44,6 +44,13 @@ double Scene::instanceArea(size_t instance) const {
         }
     }
     return 0.5 * area2;
+}
+
+glm::dvec3 chooseLocalOrigin(const glm::dvec3& lo, const glm::dvec3& hi) {
+    if (lo.x > hi.x || lo.y > hi.y || lo.z > hi.z) return glm::dvec3(0.0);
+    const glm::dvec3 centre = (lo + hi) * 0.5;
+    const double radius = 0.5 * glm::length(hi - lo);
+    return glm::length(centre) <= radius ? glm::dvec3(0.0) : centre;
 }
 
 }  // namespace bb

@@ -2,6 +2,12 @@
 // directional lights and cameras, in scene units (whatever the file uses;
 // glTF means metres, the shared Cornell box uses millimetres).
 //
+// World and local coordinates: instance transforms are composed in double
+// (Instance::exactWorldFromObject). Everything the GPU and the bakers see
+// (BakeMesh positions and bounds) is relative to Scene::origin, so a scene
+// 100 km from the world origin keeps the float precision it has at the origin
+// (a float at 5 km has 0.5 mm steps, at 100 km 8 mm).
+//
 // GL-free: plain structs, loaded by loadScene() (gltf_loader.cpp, tinygltf).
 #pragma once
 
@@ -57,8 +63,24 @@ struct Instance {
     std::string name;                // node name, or "node <index>"
     int mesh = -1;
     int node = -1;
+    // World from object rounded to float: enough for shapes (areas, normals),
+    // not for positions far from the world origin. Scenes built by hand may set
+    // only this one.
     glm::mat4 worldFromObject{1.0f};
+    // The same transform as the loader composed it, in double (see
+    // exactWorldFromObject). Set both with setWorldFromObject.
+    glm::dmat4 worldFromObjectDouble{1.0};
     float texelDensity = 0.0f;       // per-node override from extras.texelDensity (texels per scene unit); 0 = none
+
+    void setWorldFromObject(const glm::dmat4& m) {
+        worldFromObjectDouble = m;
+        worldFromObject = glm::mat4(m);
+    }
+    // worldFromObjectDouble while it still rounds to worldFromObject, else
+    // worldFromObject (a scene built or edited by hand through the float one).
+    glm::dmat4 exactWorldFromObject() const {
+        return glm::mat4(worldFromObjectDouble) == worldFromObject ? worldFromObjectDouble : glm::dmat4(worldFromObject);
+    }
 };
 
 // KHR_lights_punctual "directional": a sun. `direction` is the unit world-space
@@ -106,7 +128,11 @@ struct Scene {
     std::vector<Instance> instances;
     std::vector<DirectionalLight> lights;
     std::vector<Camera> cameras;
-    Bounds bounds;            // world space, over all instances
+    Bounds bounds;            // world space, over all instances (float: rounded far from the origin)
+    // The local origin (world space, exact): BakeMesh positions are world - origin.
+    // loadScene sets it with chooseLocalOrigin; scenes built by hand keep 0
+    // (their bake mesh is then in world space, as before).
+    glm::dvec3 origin{0.0};
     LoadReport report;
 
     size_t triangleCount() const;           // over instances (an instanced mesh counts each time)
@@ -114,6 +140,15 @@ struct Scene {
     bool allHaveUv1() const;                // every instanced primitive has TEXCOORD_1
     double instanceArea(size_t instance) const;  // world-space surface area of one instance
 };
+
+// The local origin for a scene whose world bounds (in double) are [lo, hi]:
+// 0 while the world origin lies within the bounding sphere (|centre| <=
+// radius: world coordinates are then at most twice the local ones, and scenes
+// near the origin bake exactly as they always did), else the centre (lo + hi)/2.
+// The centre is exact for a translated scene: a node translation T moves it
+// by exactly T, so world - origin gives the same floats wherever the scene is.
+// An empty box (lo > hi) gives 0.
+glm::dvec3 chooseLocalOrigin(const glm::dvec3& lo, const glm::dvec3& hi);
 
 struct LoadOptions {
     glm::vec3 defaultAlbedo{0.8f};  // for primitives without a material (glTF's default is metallic, i.e. black)

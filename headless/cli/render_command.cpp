@@ -106,7 +106,8 @@ int runRender(const RenderArgs& args) {
 #endif
     }
 
-    Camera camera = cameraIndex >= 0 ? scene.cameras[size_t(cameraIndex)]
+    // the mesh is in local space (world - mesh.origin): so is the camera
+    Camera camera = cameraIndex >= 0 ? cameraInLocalSpace(scene.cameras[size_t(cameraIndex)], mesh.origin)
                                      : framingCamera(mesh.bounds, DEFAULT_FRAMING_DIRECTION, 0.8f, aspect);
     RenderSettings settings;
     settings.mode = *mode;
