@@ -51,7 +51,7 @@ struct ViewerArgs {
     // lighting and bake flags, as `bundlebake bake`
     int directions = 256;
     int bundleRes = 0;
-    std::string memoryBudget = "512M";
+    std::string memoryBudget = "4G";
     uint64_t seed = 1;
     std::string sky = "0,0,0";
     std::string env;
@@ -660,7 +660,7 @@ int runViewer(int argc, char** argv) {
     app.add_option("--bundle-res", a.bundleRes, "Bundle resolution across the bounding sphere (0 = half a texel per pixel)")
         ->check(CLI::Range(0, 1 << 20))
         ->capture_default_str();
-    app.add_option("--memory-budget", a.memoryBudget, "GPU bytes for one tile's node buffer and head image")
+    app.add_option("--memory-budget", a.memoryBudget, "GL bytes for the whole bake: light maps, mesh, materials, and the rest for the bundle pass")
         ->capture_default_str();
     app.add_option("--seed", a.seed, "Random seed (directions, stochastic rounding)")->capture_default_str();
     app.add_option("--sky", a.sky, "Uniform sky radiance r,g,b (scene units)")->capture_default_str();

@@ -22,35 +22,28 @@
 namespace bb {
 namespace {
 
-// Per texel of every page, the covered texel whose value it shows: itself if
-// covered, else the nearest covered texel within `radius` texels (Chebyshev
-// rings, Euclidean nearest, ties to the lowest index), else -1. Packed x | y << 16.
-std::vector<int32_t> dilationSources(const std::vector<uint8_t>& covered, int res, int pages, int radius) {
-    std::vector<int32_t> source(covered.size(), -1);
-    for (int p = 0; p < pages; ++p) {
-        const size_t base = size_t(p) * res * res;
-        for (int y = 0; y < res; ++y)
-            for (int x = 0; x < res; ++x) {
-                if (covered[base + size_t(y) * res + x]) {
-                    source[base + size_t(y) * res + x] = x | (y << 16);
-                    continue;
-                }
-                int best = -1, bestD2 = 1 << 30;
-                for (int dy = -radius; dy <= radius; ++dy)
-                    for (int dx = -radius; dx <= radius; ++dx) {
-                        int qx = x + dx, qy = y + dy;
-                        if (qx < 0 || qy < 0 || qx >= res || qy >= res) continue;
-                        if (!covered[base + size_t(qy) * res + qx]) continue;
-                        int d2 = dx * dx + dy * dy;
-                        if (d2 < bestD2) {
-                            bestD2 = d2;
-                            best = qx | (qy << 16);
-                        }
+// One page of dilation codes (glsl/shared/bundle_layout.h), in place: covered
+// texels hold DILATION_SELF; every other texel gets the nearest covered texel
+// within `radius` (Euclidean, ties to the first in row order), or DILATION_NONE.
+void dilationCodes(std::vector<uint8_t>& codes, int res, int radius) {
+    for (int y = 0; y < res; ++y)
+        for (int x = 0; x < res; ++x) {
+            uint8_t& code = codes[size_t(y) * res + x];
+            if (code == DILATION_SELF) continue;
+            int best = DILATION_NONE, bestD2 = 1 << 30;
+            for (int dy = -radius; dy <= radius; ++dy)
+                for (int dx = -radius; dx <= radius; ++dx) {
+                    int qx = x + dx, qy = y + dy;
+                    if (qx < 0 || qy < 0 || qx >= res || qy >= res) continue;
+                    if (codes[size_t(qy) * res + qx] != DILATION_SELF) continue;
+                    int d2 = dx * dx + dy * dy;
+                    if (d2 < bestD2) {
+                        bestD2 = d2;
+                        best = (dx + DILATION_RADIUS) | ((dy + DILATION_RADIUS) << 4);
                     }
-                source[base + size_t(y) * res + x] = best;
-            }
-    }
-    return source;
+                }
+            code = uint8_t(best);
+        }
 }
 
 // Quantile q in [0, 1] of `values` (nearest rank below); 0 when empty.
@@ -88,9 +81,21 @@ nlohmann::json BakeStats::toJson() const {
     j["culling"] = {{"clusters", clusters}, {"triangles", triangles},
                     {"bundle_pass_triangles_drawn_fraction", double(bundleTrianglesDrawn) / drawnTiles},
                     {"update_pass_triangles_drawn_fraction", double(updateTrianglesDrawn) / drawnTiles}};
-    j["memory"] = {{"node_capacity", nodeCapacity}, {"peak_nodes_per_tile", peakNodesPerTile},
-                   {"node_buffer_bytes", nodeBufferBytes}, {"head_image_bytes", headImageBytes},
-                   {"peak_gpu_bytes", peakGpuBytes}, {"bytes_per_node", 12}, {"bytes_per_lightmap_texel", 8}};
+    // GL memory as the objects that existed hold it (GL's component sizes),
+    // peak per category; the light-map state per page texel and per covered texel
+    const double pageTexels = double(std::max<int64_t>(lightmapTexels, 1));
+    const double coveredTexelsOrOne = double(std::max<int64_t>(coveredTexels, 1));
+    nlohmann::json categories = nlohmann::json::object();
+    for (const auto& [name, bytes] : peakGpuBytesByCategory)
+        categories[name] = {{"peak_bytes", bytes}, {"bytes_per_page_texel", double(bytes) / pageTexels}};
+    j["memory"] = {{"budget_bytes", memoryBudget}, {"peak_gpu_bytes", peakGpuBytes},
+                   {"peak_gpu_bytes_per_page_texel", double(peakGpuBytes) / pageTexels},
+                   {"lightmap_state_bytes", lightmapStateBytes},
+                   {"lightmap_bytes_per_page_texel", double(lightmapStateBytes) / pageTexels},
+                   {"lightmap_bytes_per_covered_texel", double(lightmapStateBytes) / coveredTexelsOrOne},
+                   {"by_category", categories},
+                   {"node_capacity", nodeCapacity}, {"peak_nodes_per_tile", peakNodesPerTile},
+                   {"node_buffer_bytes", nodeBufferBytes}, {"head_image_bytes", headImageBytes}, {"bytes_per_node", 12}};
     j["lightmap"] = {{"texels", lightmapTexels}, {"covered_texels", coveredTexels}};
     j["direct_light"] = {{"explicit_emitters", explicitEmitters}, {"emitter_samples", emitterSampleCount}};
     double bundleSeconds = secondsBundle > 0 ? secondsBundle : 1e-9;
@@ -113,7 +118,10 @@ Status Baker::Impl::buildPrograms() {
         {&sunProgram, {"lightmap/update.vert", "lightmap/update.frag"}, "#define SUN_PASS 1\n"},
         {&resolveProgram, {"lightmap/resolve.comp"}, ""},
         {&rescaleProgram, {"lightmap/rescale.comp"}, rounding},
-        {&metaProgram, {"lightmap/meta.vert", "lightmap/meta.frag"}, ""},
+        {&metaProgram, {"lightmap/meta.vert", "lightmap/meta.frag"}, rounding},
+        {&coverageProgram, {"lightmap/meta.vert", "lightmap/meta.frag"}, "#define COVERAGE 1\n"},
+        {&dilateProgram, {"lightmap/dilate.comp"}, ""},
+        {&directFoldProgram, {"lightmap/direct_fold.comp"}, rounding},
         {&distanceProgram, {"direct/distance.vert", "direct/distance.frag"}, ""},
         {&emitterProgram, {"direct/emitter.vert", "direct/emitter.frag"}, ""},
     };
@@ -126,6 +134,7 @@ Status Baker::Impl::buildPrograms() {
 }
 
 void Baker::Impl::uploadMesh() {
+    MemoryCategory category("mesh");
     vertexBuffer = gl::Buffer::create("bake vertices", int64_t(mesh.vertices.size() * sizeof(BakeVertex)),
                                       mesh.vertices.data(), 0);
     triangleBuffer = gl::Buffer::create("bake triangles", int64_t(mesh.triangles.size() * sizeof(BakeTriangle)),
@@ -140,10 +149,10 @@ void Baker::Impl::dispatchPages(GLuint program) {
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
 }
 
-void Baker::Impl::metaPass(const Scene& scene) {
-    gl::DebugGroup group("meta pass");
-    // upload material textures (linear RGBA float, mipmapped)
+void Baker::Impl::uploadMaterials(const Scene& scene) {
+    // material textures (linear RGBA, mipmapped)
     for (size_t i = 0; i < scene.textures.size(); ++i) {
+        MemoryCategory category("materials");
         const Texture& t = scene.textures[i];
         int levels = 1 + int(std::floor(std::log2(std::max(t.width, t.height))));
         gl::Texture tex = gl::Texture::create2DLevels("material texture " + t.name, GL_RGBA16F, t.width, t.height, levels);
@@ -166,47 +175,61 @@ void Baker::Impl::metaPass(const Scene& scene) {
     });
     std::vector<uint32_t> indices;
     indices.reserve(order.size() * 3);
-    for (uint32_t t : order)
-        for (uint32_t k = 0; k < 3; ++k) indices.push_back(t * 3 + k);
-    metaIndexBuffer = gl::Buffer::create("meta indices", int64_t(indices.size() * 4), indices.data(), 0);
+    for (size_t i = 0; i < order.size(); ++i) {
+        const BakeTriangle& t = mesh.triangles[order[i]];
+        if (surfaceRuns.empty() || surfaceRuns.back().page != t.page || surfaceRuns.back().material != t.material)
+            surfaceRuns.push_back({i, 0, t.page, t.material});
+        ++surfaceRuns.back().count;
+        for (uint32_t k = 0; k < 3; ++k) indices.push_back(order[i] * 3 + k);
+    }
+    MemoryCategory category("mesh");
+    metaIndexBuffer = gl::Buffer::create("surface indices (by page, material)", int64_t(indices.size() * 4), indices.data(), 0);
     glVertexArrayElementBuffer(vao.id(), metaIndexBuffer.id());
+}
 
-    metaFbo = gl::Framebuffer::create("meta framebuffer");
-    glUseProgram(metaProgram.id());
+void Baker::Impl::drawSurface(GLuint program, bool materialUniforms) {
+    glUseProgram(program);
     glBindVertexArray(vao.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, triangleBuffer.id());
+    glBindFramebuffer(GL_FRAMEBUFFER, pageFbo.id());
     glViewport(0, 0, layout.resolution, layout.resolution);
-    const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-    const float zero[4] = {0, 0, 0, 0};
-    size_t run = 0;
-    for (int page = 0; page < layout.pageCount; ++page) {
-        glNamedFramebufferTextureLayer(metaFbo.id(), GL_COLOR_ATTACHMENT0, albedoMap.id(), 0, page);
-        glNamedFramebufferTextureLayer(metaFbo.id(), GL_COLOR_ATTACHMENT1, emissionMap.id(), 0, page);
-        glNamedFramebufferDrawBuffers(metaFbo.id(), 2, buffers);
-        CHECK_EQ(glCheckNamedFramebufferStatus(metaFbo.id(), GL_FRAMEBUFFER), GLenum(GL_FRAMEBUFFER_COMPLETE));
-        glBindFramebuffer(GL_FRAMEBUFFER, metaFbo.id());
-        glClearBufferfv(GL_COLOR, 0, zero);
-        glClearBufferfv(GL_COLOR, 1, zero);
-        while (run < order.size() && mesh.triangles[order[run]].page == uint32_t(page)) {
-            size_t end = run;
-            uint32_t m = mesh.triangles[order[run]].material;
-            while (end < order.size() && mesh.triangles[order[end]].page == uint32_t(page) &&
-                   mesh.triangles[order[end]].material == m)
-                ++end;
-            const Material& mat = materials[m];
-            glUniform3fv(metaProgram.uniform("albedo"), 1, &mat.albedo.x);
-            glUniform3fv(metaProgram.uniform("emission"), 1, &mat.emission.x);
-            glUniform1i(metaProgram.uniform("hasAlbedoTexture"), mat.albedoTexture >= 0);
-            glUniform1i(metaProgram.uniform("hasEmissionTexture"), mat.emissionTexture >= 0);
-            if (mat.albedoTexture >= 0) glBindTextureUnit(2, materialTextures[mat.albedoTexture].id());
-            if (mat.emissionTexture >= 0) glBindTextureUnit(3, materialTextures[mat.emissionTexture].id());
-            glDrawElements(GL_TRIANGLES, GLsizei((end - run) * 3), GL_UNSIGNED_INT,
-                           reinterpret_cast<const void*>(run * 3 * sizeof(uint32_t)));
-            run = end;
+    const GLint pageUniform = glGetUniformLocation(program, "page");
+    for (const SurfaceRun& run : surfaceRuns) {
+        glUniform1i(pageUniform, GLint(run.page));
+        if (materialUniforms) {
+            const Material& mat = materials[run.material];
+            glUniform3fv(glGetUniformLocation(program, "albedo"), 1, &mat.albedo.x);
+            glUniform3fv(glGetUniformLocation(program, "emission"), 1, &mat.emission.x);
+            glUniform1i(glGetUniformLocation(program, "hasAlbedoTexture"), mat.albedoTexture >= 0);
+            glUniform1i(glGetUniformLocation(program, "hasEmissionTexture"), mat.emissionTexture >= 0);
+            if (mat.albedoTexture >= 0) glBindTextureUnit(BINDING_MATERIAL_TEX, materialTextures[mat.albedoTexture].id());
+            if (mat.emissionTexture >= 0)
+                glBindTextureUnit(BINDING_MATERIAL_TEX + 1, materialTextures[mat.emissionTexture].id());
         }
+        glDrawElements(GL_TRIANGLES, GLsizei(run.count * 3), GL_UNSIGNED_INT,
+                       reinterpret_cast<const void*>(uintptr_t(run.first) * 3 * sizeof(uint32_t)));
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    glMemoryBarrier(GL_ALL_BARRIER_BITS);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+}
+
+void Baker::Impl::coveragePass() {
+    gl::DebugGroup group("coverage");
+    const uint8_t none = DILATION_NONE;
+    glClearTexImage(dilation.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_BYTE, &none);
+    glBindImageTexture(BINDING_DILATION, dilation.id(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R8UI);
+    drawSurface(coverageProgram.id(), false);
+    // padding: the nearest covered texel, page by page on the CPU (once)
+    const int res = layout.resolution;
+    const int radius = std::min(std::max(layout.padding, 1) + 1, DILATION_RADIUS);
+    std::vector<uint8_t> codes(size_t(res) * res);
+    for (int p = 0; p < layout.pageCount; ++p) {
+        gl::readTexture(dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, codes.data());
+        stats.coveredTexels += std::count(codes.begin(), codes.end(), uint8_t(DILATION_SELF));
+        dilationCodes(codes, res, radius);
+        gl::writeTexture(dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, codes.data());
+    }
+    stats.lightmapTexels = int64_t(res) * res * layout.pageCount;
 }
 
 Status Baker::Impl::init(const Scene& scene) {
@@ -244,6 +267,7 @@ Status Baker::Impl::init(const Scene& scene) {
     // importance (supplement §1) decides each leaf's pixel size
     {
         auto t = Clock::now();
+        MemoryCategory category("importance");
         auto analyzer = ImportanceAnalyzer::create();
         if (!analyzer) return analyzer.status();
         auto result = (*analyzer)->analyze(mesh, layout.resolution);
@@ -287,15 +311,79 @@ Status Baker::Impl::init(const Scene& scene) {
     stats.bundleResolution = gridSize;
     stats.pixelSize = pixelSize;
 
-    // tile limits, all read from GL: a leaf's grid is one viewport; a tile's
-    // side is the head image's; the node buffer is one SSBO binding; the
-    // budget holds the head image and the node buffer of one tile
+    // history ramp power from the largest albedo
+    if (options.historyPower >= 0) {
+        historyPower = options.historyPower;
+    } else {
+        float rho = 0;
+        for (const auto& m : materials) rho = std::max({rho, m.albedo.r, m.albedo.g, m.albedo.b});
+        rho = std::min(rho, 0.99f);
+        historyPower = std::clamp(std::round(2.0 * rho / (1.0 - rho)), 1.0, 32.0);
+    }
+    stats.historyPower = historyPower;
+    directions = makeDirections(options.directions, options.seed);
+
+    Status s = buildPrograms();
+    if (!s) return s;
+    const int64_t gpuAtStart = MemoryTracker::gpu().current();
+    uploadMesh();
+    const int pages = layout.pageCount, res = layout.resolution;
+    {
+        MemoryCategory category("light maps");
+        accum = gl::Texture::create2DArray("accumulators (fp16 RGB + W)", GL_RG32UI, res, res, pages);
+        radiance = gl::Texture::create2DArray("outgoing radiance (RGB9E5)", GL_RGB9_E5, res, res, pages);
+        direct = gl::Texture::create2DArray("direct light (fp16)", GL_RGBA16F, res, res, pages);
+        dilation = gl::Texture::create2DArray("dilation codes", GL_R8UI, res, res, pages);
+        accumAsFloat = gl::Texture::createView("accumulators as rg32f (direct light sums)", accum, GL_RG32F);
+        radianceBits = gl::Texture::createView("outgoing radiance as r32ui", radiance, GL_R32UI);
+        radianceAsFloat = gl::Texture::createView("outgoing radiance as r32f (direct light sums)", radiance, GL_R32F);
+    }
+    stats.lightmapStateBytes = accum.bytes() + radiance.bytes() + direct.bytes() + dilation.bytes();
+    glTextureParameteri(radiance.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(radiance.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    const uint32_t zero[4] = {0, 0, 0, 0};
+    glClearTexImage(accum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, zero);
+    glClearTexImage(radianceBits.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, zero);
+    glClearTexImage(direct.id(), 0, GL_RGBA, GL_FLOAT, zero);
+    pageFbo = gl::Framebuffer::create("light map page framebuffer (no attachments)");
+    glNamedFramebufferParameteri(pageFbo.id(), GL_FRAMEBUFFER_DEFAULT_WIDTH, res);
+    glNamedFramebufferParameteri(pageFbo.id(), GL_FRAMEBUFFER_DEFAULT_HEIGHT, res);
+    uploadMaterials(scene);
+    if (options.environment) {
+        MemoryCategory category("materials");
+        const auto& env = *options.environment;
+        envTexture = gl::Texture::create2D("environment", GL_RGBA32F, env.width, env.height);
+        std::vector<glm::vec4> rgba(env.pixels.size());
+        for (size_t i = 0; i < rgba.size(); ++i) rgba[i] = glm::vec4(env.pixels[i], 1.0f);
+        // file row 0 is the top (theta = 0): texture t = theta / pi, so upload rows top-down as t = 0..1
+        glTextureSubImage2D(envTexture.id(), 0, 0, 0, env.width, env.height, GL_RGBA, GL_FLOAT, rgba.data());
+        glTextureParameteri(envTexture.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTextureParameteri(envTexture.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTextureParameteri(envTexture.id(), GL_TEXTURE_WRAP_S, GL_REPEAT);
+    }
+
+    // The budget: what the light maps, mesh and materials (all fixed by the
+    // scene and layout) leave goes to the bundle pass's node buffer and head
+    // image, within the GL limits. Tile limits are all read from GL: a leaf's
+    // grid is one viewport; a tile's side is the head image's; the node buffer
+    // is one SSBO binding.
+    const int64_t fixedBytes = MemoryTracker::gpu().current() - gpuAtStart;
+    stats.memoryBudget = options.memoryBudget;
+    int64_t bundleBytes = options.bundleMemory > 0 ? options.bundleMemory : options.memoryBudget - fixedBytes;
+    constexpr int64_t kMinBundleBytes = 64 * 64 * 4 + 1024 * 12;
+    if (bundleBytes < kMinBundleBytes) {
+        auto mib = [](int64_t b) { return std::to_string((b + (1 << 20) - 1) >> 20) + " MiB"; };
+        return Status::error("--memory-budget " + mib(options.memoryBudget) + " is too small: the light maps take " +
+                             mib(stats.lightmapStateBytes) + ", the mesh and materials " +
+                             mib(fixedBytes - stats.lightmapStateBytes) + "; give at least " +
+                             mib(fixedBytes + (16 << 20)));
+    }
     maxTileSize = std::min({maxTex, maxViewport, 2048});
-    while (maxTileSize > 64 && int64_t(maxTileSize) * maxTileSize * 4 > options.memoryBudget / 4) maxTileSize /= 2;
+    while (maxTileSize > 64 && int64_t(maxTileSize) * maxTileSize * 4 > bundleBytes / 4) maxTileSize /= 2;
     int64_t headBytes = int64_t(maxTileSize) * maxTileSize * 4;
     GLint64 maxSsbo = 0;
     glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxSsbo);
-    nodeCapacity = std::min<int64_t>({(options.memoryBudget - headBytes) / 12, maxSsbo / 12, int64_t(0xFFFFFFFEll)});
+    nodeCapacity = std::min<int64_t>({(bundleBytes - headBytes) / 12, maxSsbo / 12, int64_t(0xFFFFFFFEll)});
     if (nodeCapacity < 1024)
         return Status::error("--memory-budget is too small: the node buffer would hold fewer than 1024 nodes");
     stats.nodeCapacity = nodeCapacity;
@@ -312,41 +400,6 @@ Status Baker::Impl::init(const Scene& scene) {
         for (const Cluster& c : clusters) imax = std::max(imax, c.maxImportance);
         if (imax > 0.0f) sunPixelSize = pixelForImportance(imax, tilerOptions.pixelsPerTexel);
     }
-
-    // history ramp power from the largest albedo
-    if (options.historyPower >= 0) {
-        historyPower = options.historyPower;
-    } else {
-        float rho = 0;
-        for (const auto& m : materials) rho = std::max({rho, m.albedo.r, m.albedo.g, m.albedo.b});
-        rho = std::min(rho, 0.99f);
-        historyPower = std::clamp(std::round(2.0 * rho / (1.0 - rho)), 1.0, 32.0);
-    }
-    stats.historyPower = historyPower;
-    directions = makeDirections(options.directions, options.seed);
-
-    Status s = buildPrograms();
-    if (!s) return s;
-    uploadMesh();
-    const int pages = layout.pageCount, res = layout.resolution;
-    albedoMap = gl::Texture::create2DArray("albedo map", GL_RGBA16F, res, res, pages);
-    emissionMap = gl::Texture::create2DArray("emission map", GL_RGBA16F, res, res, pages);
-    accum = gl::Texture::create2DArray("accumulators (fp16 RGB+W)", GL_RG32UI, res, res, pages);
-    sunMap = gl::Texture::create2DArray("direct sun map", GL_RGBA32F, res, res, pages);
-    emitterMap = gl::Texture::create2DArray("direct emitter map", GL_RGBA32F, res, res, pages);
-    radiance = gl::Texture::create2DArray("outgoing radiance map", GL_RGBA32F, res, res, pages);
-    resolved = gl::Texture::create2DArray("resolved light map", GL_RGBA32F, res, res, pages);
-    glTextureParameteri(radiance.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTextureParameteri(radiance.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    const uint32_t zeroU[4] = {0, 0, 0, 0};
-    const float zeroF[4] = {0, 0, 0, 0};
-    glClearTexImage(accum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, zeroU);
-    glClearTexImage(sunMap.id(), 0, GL_RGBA, GL_FLOAT, zeroF);
-    glClearTexImage(emitterMap.id(), 0, GL_RGBA, GL_FLOAT, zeroF);
-    glClearTexImage(radiance.id(), 0, GL_RGBA, GL_FLOAT, zeroF);
-    pageFbo = gl::Framebuffer::create("light map page framebuffer (no attachments)");
-    glNamedFramebufferParameteri(pageFbo.id(), GL_FRAMEBUFFER_DEFAULT_WIDTH, res);
-    glNamedFramebufferParameteri(pageFbo.id(), GL_FRAMEBUFFER_DEFAULT_HEIGHT, res);
     {
         // the bundle pass: its buffers start small and grow to what the tiles predict
         const BundleScene scene{&mesh, &clusters, vao.id(), vertexBuffer.id(), triangleBuffer.id(), radiance.id(),
@@ -358,48 +411,33 @@ Status Baker::Impl::init(const Scene& scene) {
         tracer = std::move(t.value());
     }
 
-    if (options.environment) {
-        const auto& env = *options.environment;
-        envTexture = gl::Texture::create2D("environment", GL_RGBA32F, env.width, env.height);
-        std::vector<glm::vec4> rgba(env.pixels.size());
-        for (size_t i = 0; i < rgba.size(); ++i) rgba[i] = glm::vec4(env.pixels[i], 1.0f);
-        // file row 0 is the top (theta = 0): texture t = theta / pi, so upload rows top-down as t = 0..1
-        glTextureSubImage2D(envTexture.id(), 0, 0, 0, env.width, env.height, GL_RGBA, GL_FLOAT, rgba.data());
-        glTextureParameteri(envTexture.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-        glTextureParameteri(envTexture.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-        glTextureParameteri(envTexture.id(), GL_TEXTURE_WRAP_S, GL_REPEAT);
-    }
-
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);
     glDisable(GL_BLEND);
-    metaPass(scene);
-
-    // coverage
-    std::vector<glm::u16vec4> texels(size_t(res) * res * pages);
-    glGetTextureImage(albedoMap.id(), 0, GL_RGBA, GL_HALF_FLOAT, GLsizei(texels.size() * 8), texels.data());
-    stats.lightmapTexels = int64_t(texels.size());
-    std::vector<uint8_t> covered(texels.size());
-    for (size_t i = 0; i < texels.size(); ++i) {
-        covered[i] = texels[i].w != 0;
-        stats.coveredTexels += covered[i];
-    }
-    std::vector<int32_t> source = dilationSources(covered, res, pages, std::max(layout.padding, 1) + 1);
-    dilationSource = gl::Texture::create2DArray("dilation source texels", GL_R32I, res, res, pages);
-    glTextureSubImage3D(dilationSource.id(), 0, 0, 0, 0, res, res, pages, GL_RED_INTEGER, GL_INT, source.data());
+    coveragePass();
     stats.secondsSetup = secondsSince(t0);
 
+    // the direct light, summed in float in views of the accumulators and the
+    // radiance map (both still unused), folded into the fp16 direct map
     stats.explicitEmitters = useExplicitEmitters();
     auto te = Clock::now();
-    if (stats.explicitEmitters) bakeEmitters();
+    if (stats.explicitEmitters) {
+        bakeEmitters();
+        foldDirect(false);
+    }
     glFinish();
     stats.secondsEmitters = secondsSince(te);
     auto ts = Clock::now();
-    bakeSun();
+    if (!lights.empty()) {
+        bakeSun();
+        foldDirect(true);
+    }
+    glFinish();
     stats.secondsSun = secondsSince(ts);
     auto tr = Clock::now();
-    resolveInto(true, radiance);
+    refreshRadiance(0xFFFFFFFFu);
     stats.secondsResolve += secondsSince(tr);
+    noteMemory();
     return Status::ok();
 }
 
@@ -450,7 +488,14 @@ void Baker::Impl::run(double seconds, bool wholeDirections) {
             stepTile();
         if (secondsSince(t0) >= seconds) break;
     }
+    noteMemory();
+}
+
+void Baker::Impl::noteMemory() {
     stats.peakGpuBytes = MemoryTracker::gpu().peak();
+    stats.peakGpuBytesByCategory.clear();
+    for (const auto& [name, f] : MemoryTracker::gpu().categories())
+        if (f.peak > 0) stats.peakGpuBytesByCategory[name] = f.peak;
 }
 
 BakeProgress Baker::step(double seconds) {
@@ -469,12 +514,15 @@ BakeProgress Baker::progress() const {
 
 LightmapPages Baker::readLightmaps() {
     Impl& m = *impl_;
-    m.resolveInto(false, m.resolved);
     const int res = m.layout.resolution;
-    std::vector<glm::vec4> texels(size_t(res) * res * m.layout.pageCount);
-    glGetTextureImage(m.resolved.id(), 0, GL_RGBA, GL_FLOAT, GLsizei(texels.size() * 16), texels.data());
-    std::vector<glm::u16vec4> albedo(texels.size());
-    glGetTextureImage(m.albedoMap.id(), 0, GL_RGBA, GL_HALF_FLOAT, GLsizei(albedo.size() * 8), albedo.data());
+    // resolved band by band (at most 64 MiB of GL memory)
+    const int rows = std::clamp(int((int64_t(64) << 20) / (int64_t(res) * 16)), 1, res);
+    gl::Texture band;
+    {
+        MemoryCategory category("read-back");
+        band = gl::Texture::create2DArray("light map read-back band", GL_RGBA32F, res, rows, 1);
+    }
+    std::vector<glm::vec4> texels(size_t(res) * rows);
     LightmapPages out;
     out.resolution = res;
     for (int p = 0; p < m.layout.pageCount; ++p) {
@@ -482,29 +530,32 @@ LightmapPages Baker::readLightmaps() {
         img.width = img.height = res;
         img.pixels.resize(size_t(res) * res);
         std::vector<uint8_t> cov(size_t(res) * res);
-        for (size_t i = 0; i < img.pixels.size(); ++i) {
-            size_t k = size_t(p) * res * res + i;
-            img.pixels[i] = glm::vec3(texels[k]);
-            cov[i] = albedo[k].w != 0;
+        gl::readTexture(m.dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, cov.data());
+        for (uint8_t& c : cov) c = c == DILATION_SELF;
+        for (int y0 = 0; y0 < res; y0 += rows) {
+            const int n = std::min(rows, res - y0);
+            m.resolveInto(band, y0, n, p, 1);
+            gl::readTexture(band.id(), 0, 0, 0, res, n, 1, GL_RGBA, GL_FLOAT, 16, texels.data());
+            for (size_t i = 0; i < size_t(n) * res; ++i) img.pixels[size_t(y0) * res + i] = glm::vec3(texels[i]);
         }
         out.pages.push_back(std::move(img));
         out.covered.push_back(std::move(cov));
     }
+    m.noteMemory();
     return out;
 }
 
 std::vector<std::vector<glm::vec4>> Baker::readAccumulators() {
     Impl& m = *impl_;
     const int res = m.layout.resolution;
-    std::vector<glm::uvec2> raw(size_t(res) * res * m.layout.pageCount);
-    glGetTextureImage(m.accum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, GLsizei(raw.size() * 8), raw.data());
+    std::vector<glm::uvec2> raw(size_t(res) * res);
     std::vector<std::vector<glm::vec4>> out(size_t(m.layout.pageCount));
-    for (int p = 0; p < m.layout.pageCount; ++p)
-        for (int i = 0; i < res * res; ++i) {
-            glm::uvec2 v = raw[size_t(p) * res * res + i];
+    for (int p = 0; p < m.layout.pageCount; ++p) {
+        gl::readTexture(m.accum.id(), 0, 0, p, res, res, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
+        for (const glm::uvec2& v : raw)
             out[size_t(p)].push_back(glm::vec4(halfToFloat(uint16_t(v.x & 0xFFFF)), halfToFloat(uint16_t(v.x >> 16)),
                                                halfToFloat(uint16_t(v.y & 0xFFFF)), halfToFloat(uint16_t(v.y >> 16))));
-        }
+    }
     return out;
 }
 
@@ -566,7 +617,15 @@ Baker::BundleCapture Baker::captureBundle(const glm::vec3& dir) {
 const BakeStats& Baker::stats() const { return impl_->stats; }
 const BakeMesh& Baker::mesh() const { return impl_->mesh; }
 
-void Baker::resolveLightmaps() { impl_->resolveInto(false, impl_->resolved); }
+void Baker::resolveLightmaps() {
+    Impl& m = *impl_;
+    if (!m.resolved) {
+        MemoryCategory category("viewer");
+        m.resolved = gl::Texture::create2DArray("resolved light map", GL_RGBA32F, m.layout.resolution,
+                                                m.layout.resolution, m.layout.pageCount);
+    }
+    m.resolveInto(m.resolved, 0, m.layout.resolution, 0, m.layout.pageCount);
+}
 
 uint32_t Baker::lightmapTextureId() const { return impl_->resolved.id(); }
 

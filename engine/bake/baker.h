@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -42,7 +43,11 @@ struct BakeOptions {
     // grid over the whole scene at the mean texel density, cut into tiles.
     enum class Tiling { Adaptive, Uniform } tiling = Tiling::Adaptive;
     bool cull = true;                 // per tile, draw only the clusters whose bounds meet it (both passes)
-    int64_t memoryBudget = 512ll << 20;  // bytes for the node buffer + head image of one tile
+    // GL bytes for the whole bake: light-map state (21 bytes a page texel), mesh
+    // (172 bytes a triangle), materials, and what is left for one tile's node
+    // buffer and head image. A bake that does not fit fails at create().
+    int64_t memoryBudget = 4ll << 30;
+    int64_t bundleMemory = 0;         // > 0: one tile's node buffer + head image exactly (tests); 0 = what the budget leaves
     uint64_t seed = 1;
     glm::vec3 sky{0.0f};              // uniform sky radiance (scene units)
     std::optional<io::ImageRgb> environment;  // equirectangular environment radiance; replaces sky
@@ -84,6 +89,9 @@ struct BakeStats {
     int64_t nodeBufferBytes = 0;
     int64_t headImageBytes = 0;
     int64_t peakGpuBytes = 0;
+    int64_t memoryBudget = 0;
+    int64_t lightmapStateBytes = 0;   // the light-map textures (accumulators, radiance, direct, dilation)
+    std::map<std::string, int64_t> peakGpuBytesByCategory;  // MemoryCategory names
     int64_t lightmapTexels = 0;
     int64_t coveredTexels = 0;
     std::vector<double> predictedOverActual;  // per tile: predicted nodes / actual nodes
@@ -176,12 +184,12 @@ public:
 
     // --- live view (viewer, render tests) -------------------------------------
     // Resolves the current light maps into the texture lightmapTextureId()
-    // names, on the GPU, without reading back (readLightmaps does the same and
-    // reads back). Costs one compute pass over the pages.
+    // names (made on the first call: 16 bytes a page texel, outside the bake's
+    // state), on the GPU, without reading back. One compute pass over the pages.
     void resolveLightmaps();
     // GL name of the resolved light maps: RGBA32F 2D array, one layer per page,
     // rgb = L_lm (E/pi), a = 1 where a value exists (padding dilated). Owned by
-    // the Baker; valid for its life; filled by resolveLightmaps()/readLightmaps().
+    // the Baker; 0 before the first resolveLightmaps(), which fills it.
     uint32_t lightmapTextureId() const;
     // The bundle plane of the latest direction (direction 0's uniform grid
     // before any), for overlays: frame, the finest leaf's pixel grid over the

@@ -44,13 +44,28 @@ struct Baker::Impl {
     // GL objects
     gl::Buffer vertexBuffer, triangleBuffer, metaIndexBuffer;
     gl::VertexArray vao;
-    gl::Texture albedoMap, emissionMap, accum, sunMap, radiance, resolved, envTexture, dilationSource;
-    gl::Framebuffer pageFbo, metaFbo;
-    gl::Program updateProgram, sunProgram, resolveProgram, rescaleProgram, metaProgram, distanceProgram,
-        emitterProgram;
-    gl::Texture emitterMap;
+    // Light-map state, per page texel (21 bytes; BakeStats::memory):
+    //   accum      RG32UI  the running mean of incoming radiance (fp16 RGB) and its weight (fp16)
+    //   radiance   RGB9_E5 outgoing radiance Lo the bundle pass samples (meta.frag writes it)
+    //   direct     RGBA16F direct light L_lm (sun + explicit emitters)
+    //   dilation   R8UI    the covered texel each texel shows (DILATION_* codes)
+    // While the direct light is baked, its float sums live in views of accum
+    // and radiance (lib/direct_scratch.glsl). Albedo and emission are not
+    // stored: the outgoing pass reads them from the materials.
+    gl::Texture accum, radiance, direct, dilation;
+    gl::Texture accumAsFloat, radianceBits, radianceAsFloat;  // views: rg32f, r32ui, r32f
+    gl::Texture resolved;  // the whole light map L_lm, made on first use (the viewer's)
+    gl::Texture envTexture;
+    gl::Framebuffer pageFbo;
+    gl::Program updateProgram, sunProgram, resolveProgram, rescaleProgram, metaProgram, coverageProgram,
+        dilateProgram, directFoldProgram, distanceProgram, emitterProgram;
     std::vector<glm::vec3> textureMeans;  // mean linear RGB of each scene texture (explicit emitters)
     std::vector<gl::Texture> materialTextures;
+    struct SurfaceRun {
+        size_t first;  // position in metaIndexBuffer, in triangles
+        uint32_t count, page, material;
+    };
+    std::vector<SurfaceRun> surfaceRuns;  // metaIndexBuffer's (page, material) runs
     int64_t nodeCapacity = 0;     // nodes the budget allows in one tile
     int subpixelBits = 8;         // GL_SUBPIXEL_BITS
     std::unique_ptr<BundleTracer> tracer;
@@ -61,8 +76,13 @@ struct Baker::Impl {
     Status init(const Scene& scene);
     Status buildPrograms();
     void uploadMesh();
-    void metaPass(const Scene& scene);
+    void uploadMaterials(const Scene& scene);
+    // Draws every page's triangles (meta.vert) into pageFbo in runs of one
+    // page and material, setting `page` and, if asked, the material's uniforms and textures.
+    void drawSurface(GLuint program, bool materialUniforms);
+    void coveragePass();
     void bakeSun();
+    void foldDirect(bool perSample);
     bool useExplicitEmitters() const;
     void bakeEmitters();
     // The root square of direction d: the uniform grid, or the adaptive root.
@@ -75,7 +95,11 @@ struct Baker::Impl {
     // Baker::step (whole directions) and stepTiles: until `seconds` have passed, at least one step.
     void run(double seconds, bool wholeDirections);
     void finishDirection(int k);
-    void resolveInto(bool radianceOut, gl::Texture& target);
+    void noteMemory();  // peaks into stats
+    // The outgoing radiance the bundles read: meta.frag over every page, then the padding.
+    void refreshRadiance(uint32_t key);  // key: the direction just done (random numbers)
+    // L_lm of the region (x 0.., y0.., page) + (width, rows, pages) into `target` at (0, 0, 0).
+    void resolveInto(const gl::Texture& target, int y0, int rows, int page0, int pages);
     void dispatchPages(GLuint program);
 };
 

@@ -17,7 +17,7 @@
 namespace bb {
 
 namespace {
-constexpr char CHECKPOINT_MAGIC[8] = {'B', 'B', 'C', 'K', 'P', 'T', '0', '2'};
+constexpr char CHECKPOINT_MAGIC[8] = {'B', 'B', 'C', 'K', 'P', 'T', '0', '3'};
 
 uint64_t fnv1a(const void* data, size_t bytes, uint64_t h = 1469598103934665603ull) {
     const auto* p = static_cast<const uint8_t*>(data);
@@ -54,8 +54,9 @@ Status Baker::saveCheckpoint(const std::string& path) {
     // a checkpoint holds whole directions: finish the one in flight (the same tiles an uninterrupted bake draws)
     if (m.directionActive) m.stepDirection();
     const int res = m.layout.resolution;
-    std::vector<glm::uvec2> raw(size_t(res) * res * m.layout.pageCount);
-    glGetTextureImage(m.accum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, GLsizei(raw.size() * 8), raw.data());
+    const int pages = m.layout.pageCount;
+    std::vector<glm::uvec2> raw(size_t(res) * res * pages);
+    gl::readTexture(m.accum.id(), 0, 0, 0, res, res, pages, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
     CheckpointHeader h{};
     std::memcpy(h.magic, CHECKPOINT_MAGIC, 8);
     h.key = checkpointKey(m.mesh, m.layout, m.options, m.historyPower);
@@ -64,11 +65,11 @@ Status Baker::saveCheckpoint(const std::string& path) {
     h.pages = m.layout.pageCount;
     h.accumScale = m.accumScale;
     // the radiance map too: it is refreshed on a schedule, so it can be older than the accumulators
-    std::vector<glm::vec4> radiance(raw.size());
-    glGetTextureImage(m.radiance.id(), 0, GL_RGBA, GL_FLOAT, GLsizei(radiance.size() * 16), radiance.data());
+    std::vector<uint32_t> radiance(raw.size());  // RGB9E5 bits
+    gl::readTexture(m.radianceBits.id(), 0, 0, 0, res, res, pages, GL_RED_INTEGER, GL_UNSIGNED_INT, 4, radiance.data());
     std::string bytes(reinterpret_cast<const char*>(&h), sizeof h);
     bytes.append(reinterpret_cast<const char*>(raw.data()), raw.size() * sizeof(glm::uvec2));
-    bytes.append(reinterpret_cast<const char*>(radiance.data()), radiance.size() * sizeof(glm::vec4));
+    bytes.append(reinterpret_cast<const char*>(radiance.data()), radiance.size() * sizeof(uint32_t));
     return io::writeFileAtomic(path, bytes);
 }
 
@@ -79,20 +80,20 @@ Status Baker::loadCheckpoint(const std::string& path) {
     CheckpointHeader h{};
     const int res = m.layout.resolution;
     std::vector<glm::uvec2> raw(size_t(res) * res * m.layout.pageCount);
-    std::vector<glm::vec4> radiance(raw.size());
+    std::vector<uint32_t> radiance(raw.size());
     bool ok = std::fread(&h, sizeof h, 1, f) == 1 && std::memcmp(h.magic, CHECKPOINT_MAGIC, 8) == 0 &&
               h.resolution == res && h.pages == m.layout.pageCount &&
               std::fread(raw.data(), sizeof(glm::uvec2), raw.size(), f) == raw.size() &&
-              std::fread(radiance.data(), sizeof(glm::vec4), radiance.size(), f) == radiance.size();
+              std::fread(radiance.data(), sizeof(uint32_t), radiance.size(), f) == radiance.size();
     std::fclose(f);
     if (!ok) return Status::error(path + " is not a bundlebake checkpoint of this layout");
     if (h.key != checkpointKey(m.mesh, m.layout, m.options, m.historyPower))
         return Status::error(path + " was written for another scene or other bake options; remove it or bake without --resume");
     if (h.directionsDone < 0 || h.directionsDone > m.options.directions)
         return Status::error(path + ": corrupt progress count");
-    glTextureSubImage3D(m.accum.id(), 0, 0, 0, 0, res, res, m.layout.pageCount, GL_RG_INTEGER, GL_UNSIGNED_INT,
-                        raw.data());
-    glTextureSubImage3D(m.radiance.id(), 0, 0, 0, 0, res, res, m.layout.pageCount, GL_RGBA, GL_FLOAT, radiance.data());
+    gl::writeTexture(m.accum.id(), 0, 0, 0, res, res, m.layout.pageCount, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
+    gl::writeTexture(m.radianceBits.id(), 0, 0, 0, res, res, m.layout.pageCount, GL_RED_INTEGER, GL_UNSIGNED_INT, 4,
+                     radiance.data());
     m.stats.directionsDone = h.directionsDone;
     m.accumScale = h.accumScale;
     return Status::ok();

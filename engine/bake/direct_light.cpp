@@ -8,6 +8,7 @@
 #include "bake/baker_impl.h"
 #include "bake/rounding.h"
 #include "core/check.h"
+#include "core/memory.h"
 #include "gl/gl.h"
 #include "glsl/shared/bundle_layout.h"
 #include <glm/gtc/matrix_transform.hpp>
@@ -15,7 +16,7 @@
 namespace bb {
 
 void Baker::Impl::bakeSun() {
-    if (lights.empty()) return;
+    MemoryCategory category("bundles");
     int j = std::max(1, options.sunJitter);
     // Adaptive: the sun at the scene's finest pixel, jittered by it (a fraction
     // of the mean texel's pixel in leaves of finer pixels bunched the samples:
@@ -29,7 +30,9 @@ void Baker::Impl::bakeSun() {
             glUseProgram(sunProgram.id());
             glUniform3fv(sunProgram.uniform("sunIrradiance"), 1, &irradiance.x);
             glUniform1f(sunProgram.uniform("depthBias"), depthBias);
-            glBindImageTexture(BINDING_SUN, sunMap.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
+            glBindImageTexture(BINDING_SCRATCH_RG, accumAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32F);
+            glBindImageTexture(BINDING_SCRATCH_B, radianceAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
+            glBindImageTexture(BINDING_DIRECT, direct.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA16F);
             return sunProgram.id();
         };
         for (int jy = 0; jy < j; ++jy)
@@ -58,6 +61,7 @@ bool Baker::Impl::useExplicitEmitters() const {
 
 void Baker::Impl::bakeEmitters() {
     gl::DebugGroup group("explicit emitters");
+    MemoryCategory category("direct light");
     // emitters and their sample counts, proportional to area x luminance (>= 1 each)
     struct Emitter {
         size_t triangle;
@@ -149,7 +153,8 @@ void Baker::Impl::bakeEmitters() {
             glUniform1f(emitterProgram.uniform("distanceBias"), distanceBias);
             glUniform1f(emitterProgram.uniform("footprintPerDistance"), 1.0f / float(size));
             glBindTextureUnit(0, cube.id());
-            glBindImageTexture(BINDING_DIRECT, emitterMap.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
+            glBindImageTexture(BINDING_SCRATCH_RG, accumAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32F);
+            glBindImageTexture(BINDING_SCRATCH_B, radianceAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
             glBindFramebuffer(GL_FRAMEBUFFER, pageFbo.id());
             glViewport(0, 0, layout.resolution, layout.resolution);
             for (int page = 0; page < layout.pageCount; ++page) {
@@ -163,6 +168,17 @@ void Baker::Impl::bakeEmitters() {
         }
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+void Baker::Impl::foldDirect(bool perSample) {
+    gl::DebugGroup group("fold direct light");
+    glUseProgram(directFoldProgram.id());
+    glUniform1i(directFoldProgram.uniform("perSample"), perSample);
+    glUniform1ui(directFoldProgram.uniform("randomSeed"), pcgHash(uint32_t(options.seed) ^ (perSample ? 0x51u : 0xE4u)));
+    glBindImageTexture(BINDING_SCRATCH_RG, accumAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32F);
+    glBindImageTexture(BINDING_SCRATCH_B, radianceAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
+    glBindImageTexture(BINDING_DIRECT, direct.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA16F);
+    dispatchPages(directFoldProgram.id());
 }
 
 }  // namespace bb

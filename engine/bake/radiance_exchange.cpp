@@ -2,7 +2,8 @@
 // Tokuyoshi et al. 2013): the history ramp's weight, the direction's tiles
 // through the bundle tracer with the update pass (glsl/lightmap/update.frag)
 // after each, and the scheduled refresh of the outgoing radiance the next
-// bundles read (the resolve, glsl/lightmap/resolve.comp).
+// bundles read (glsl/lightmap/meta.frag, dilate.comp); the light map itself
+// (glsl/lightmap/resolve.comp) for read-backs and the viewer.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -10,6 +11,7 @@
 #include "bake/baker_impl.h"
 #include "bake/rounding.h"
 #include "core/check.h"
+#include "core/memory.h"
 #include "gl/gl.h"
 #include "glsl/shared/bundle_layout.h"
 #include "bake/directions.h"
@@ -51,6 +53,7 @@ void Baker::Impl::beginDirection(int k) {
 }
 
 void Baker::Impl::stepTile() {
+    MemoryCategory category("bundles");
     const int k = stats.directionsDone;
     if (!directionActive) beginDirection(k);
     if (!tracer->done()) tracer->next(directionUpdate);
@@ -66,26 +69,40 @@ void Baker::Impl::finishDirection(int k) {
     const int interval = std::clamp(k / 32, 1, 8);
     if ((k + 1) % interval == 0 || k + 1 == options.directions) {
         auto tr = Clock::now();
-        resolveInto(true, radiance);
+        refreshRadiance(uint32_t(k));
         glFinish();
         stats.secondsResolve += secondsSince(tr);
     }
     ++stats.directionsDone;
 }
 
-void Baker::Impl::resolveInto(bool radianceOut, gl::Texture& target) {
+void Baker::Impl::refreshRadiance(uint32_t key) {
+    gl::DebugGroup group("outgoing radiance");
+    glUseProgram(metaProgram.id());
+    glUniform1i(metaProgram.uniform("includeEmission"), !stats.explicitEmitters);
+    glUniform1ui(metaProgram.uniform("randomSeed"), pcgHash(uint32_t(options.seed) ^ pcgHash(key ^ 0x5bd1e995u)));
+    glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RG32UI);
+    glBindImageTexture(BINDING_DIRECT, direct.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
+    glBindImageTexture(BINDING_RADIANCE_BITS, radianceBits.id(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32UI);
+    drawSurface(metaProgram.id(), true);
+    glUseProgram(dilateProgram.id());
+    glBindImageTexture(BINDING_DILATION, dilation.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_R8UI);
+    glBindImageTexture(BINDING_RADIANCE_BITS, radianceBits.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32UI);
+    dispatchPages(dilateProgram.id());
+}
+
+void Baker::Impl::resolveInto(const gl::Texture& target, int y0, int rows, int page0, int pages) {
     gl::DebugGroup group("resolve");
     glUseProgram(resolveProgram.id());
-    glUniform1i(resolveProgram.uniform("radianceOut"), radianceOut);
-    glUniform1i(resolveProgram.uniform("includeEmission"), !stats.explicitEmitters);
-    glBindImageTexture(7, emitterMap.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
-    glBindImageTexture(1, accum.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RG32UI);
-    glBindImageTexture(2, sunMap.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
-    glBindImageTexture(3, albedoMap.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
-    glBindImageTexture(4, emissionMap.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
-    glBindImageTexture(5, target.id(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glBindImageTexture(6, dilationSource.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_R32I);
-    dispatchPages(resolveProgram.id());
+    glUniform3i(resolveProgram.uniform("origin"), 0, y0, page0);
+    glUniform1i(resolveProgram.uniform("pageCount"), pages);
+    glUniform2i(resolveProgram.uniform("pageSize"), layout.resolution, rows);
+    glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RG32UI);
+    glBindImageTexture(BINDING_DIRECT, direct.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
+    glBindImageTexture(BINDING_DILATION, dilation.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_R8UI);
+    glBindImageTexture(BINDING_TARGET, target.id(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glDispatchCompute(GLuint(layout.resolution + 7) / 8, GLuint(rows + 7) / 8, GLuint(pages));
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
 }
 
 }  // namespace bb

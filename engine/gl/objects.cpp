@@ -3,13 +3,15 @@
 #include "core/check.h"
 #include "core/memory.h"
 
+#include <algorithm>
+
 namespace bb::gl {
 
 template <class D>
 void Object<D>::reset() {
     if (name_) {
         D::destroy(name_);
-        if (bytes_) MemoryTracker::gpu().release(bytes_);
+        if (bytes_) MemoryTracker::gpu().release(bytes_, category_);
     }
     name_ = 0;
     bytes_ = 0;
@@ -25,9 +27,10 @@ void Object<D>::adopt(GLuint name, GLenum labelKind, const std::string& label) {
 
 template <class D>
 void Object<D>::setBytes(int64_t bytes) {
-    if (bytes_) MemoryTracker::gpu().release(bytes_);
+    if (bytes_) MemoryTracker::gpu().release(bytes_, category_);
     bytes_ = bytes;
-    if (bytes_) MemoryTracker::gpu().allocate(bytes_);
+    category_ = MemoryTracker::currentCategory();
+    if (bytes_) MemoryTracker::gpu().allocate(bytes_, category_);
 }
 
 template class Object<Buffer>;
@@ -48,14 +51,51 @@ Buffer Buffer::create(const std::string& label, int64_t size, const void* data, 
     return b;
 }
 
-int bytesPerTexel(GLenum f) {
-    switch (f) {
-    case GL_R32UI: case GL_R32F: case GL_RGBA8: case GL_R32I: case GL_SRGB8_ALPHA8: return 4;
-    case GL_RGBA16F: case GL_RG32F: case GL_RG32UI: return 8;
-    case GL_RGBA32F: case GL_RGBA32UI: return 16;
-    case GL_DEPTH_COMPONENT32F: case GL_DEPTH_COMPONENT24: return 4;
-    default: CHECK(!"bytesPerTexel: unknown format"); return 0;
+int64_t bytesPerTexel(GLuint texture) {
+    const GLenum sizes[] = {GL_TEXTURE_RED_SIZE,   GL_TEXTURE_GREEN_SIZE,   GL_TEXTURE_BLUE_SIZE, GL_TEXTURE_ALPHA_SIZE,
+                            GL_TEXTURE_DEPTH_SIZE, GL_TEXTURE_STENCIL_SIZE, GL_TEXTURE_SHARED_SIZE};
+    int64_t bits = 0;
+    for (GLenum s : sizes) {
+        GLint v = 0;
+        glGetTextureLevelParameteriv(texture, 0, s, &v);
+        bits += v;
     }
+    CHECK_GT(bits, 0);
+    return (bits + 7) / 8;
+}
+
+namespace {
+// Rows per call so that one call moves at most 256 MiB.
+int rowsPerCall(int width, int texelBytes) {
+    return int(std::max<int64_t>(1, (int64_t(256) << 20) / (int64_t(width) * texelBytes)));
+}
+}  // namespace
+
+void readTexture(GLuint texture, int x, int y, int z, int width, int height, int depth, GLenum format, GLenum type,
+                 int texelBytes, void* pixels) {
+    const int rows = rowsPerCall(width, texelBytes);
+    auto* out = static_cast<uint8_t*>(pixels);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    for (int layer = 0; layer < depth; ++layer)
+        for (int r = 0; r < height; r += rows) {
+            const int n = std::min(rows, height - r);
+            const int64_t bytes = int64_t(n) * width * texelBytes;
+            glGetTextureSubImage(texture, 0, x, y + r, z + layer, width, n, 1, format, type, GLsizei(bytes), out);
+            out += bytes;
+        }
+}
+
+void writeTexture(GLuint texture, int x, int y, int z, int width, int height, int depth, GLenum format, GLenum type,
+                  int texelBytes, const void* pixels) {
+    const int rows = rowsPerCall(width, texelBytes);
+    const auto* in = static_cast<const uint8_t*>(pixels);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    for (int layer = 0; layer < depth; ++layer)
+        for (int r = 0; r < height; r += rows) {
+            const int n = std::min(rows, height - r);
+            glTextureSubImage3D(texture, 0, x, y + r, z + layer, width, n, 1, format, type, in);
+            in += int64_t(n) * width * texelBytes;
+        }
 }
 
 namespace {
@@ -86,8 +126,23 @@ Texture Texture::adoptTexture(GLuint name, const std::string& label, GLenum inte
     t.height = height;
     t.layers = layers;
     t.format = internalFormat;
-    int64_t bytes = int64_t(width) * height * layers * bytesPerTexel(internalFormat);
+    int64_t bytes = int64_t(width) * height * layers * bytesPerTexel(name);
     t.setBytes(levels > 1 ? bytes * 4 / 3 : bytes);
+    return t;
+}
+
+Texture Texture::createView(const std::string& label, const Texture& source, GLenum internalFormat) {
+    GLuint name = 0;
+    glGenTextures(1, &name);
+    GLint target = 0;
+    glGetTextureParameteriv(source.id(), GL_TEXTURE_TARGET, &target);
+    glTextureView(name, GLenum(target), source.id(), internalFormat, 0, 1, 0, GLuint(source.layers));
+    Texture t;
+    t.adopt(name, GL_TEXTURE, label);
+    t.width = source.width;
+    t.height = source.height;
+    t.layers = source.layers;
+    t.format = internalFormat;
     return t;
 }
 

@@ -1,6 +1,8 @@
 // Move-only RAII owners of GL names, each labelled with glObjectLabel so
 // debug output and captures name them. Buffers and textures report their
-// bytes to MemoryTracker::gpu(). Requires a current context for create/destroy.
+// bytes to MemoryTracker::gpu() under the MemoryCategory in scope when they
+// were made; a texture's bytes are what GL reports its level 0 stores.
+// Requires a current context for create/destroy.
 #pragma once
 
 #include <cstdint>
@@ -18,12 +20,14 @@ public:
     Object() = default;
     Object(const Object&) = delete;
     Object& operator=(const Object&) = delete;
-    Object(Object&& o) noexcept : name_(std::exchange(o.name_, 0)), bytes_(std::exchange(o.bytes_, 0)) {}
+    Object(Object&& o) noexcept
+        : name_(std::exchange(o.name_, 0)), bytes_(std::exchange(o.bytes_, 0)), category_(o.category_) {}
     Object& operator=(Object&& o) noexcept {
         if (this != &o) {
             reset();
             name_ = std::exchange(o.name_, 0);
             bytes_ = std::exchange(o.bytes_, 0);
+            category_ = o.category_;
         }
         return *this;
     }
@@ -39,6 +43,7 @@ protected:
     void setBytes(int64_t bytes);
     GLuint name_ = 0;
     int64_t bytes_ = 0;
+    const char* category_ = "other";
 };
 
 class Buffer : public Object<Buffer> {
@@ -60,6 +65,9 @@ public:
     // 2D array texture, one level, `layers` layers (light map pages).
     static Texture create2DArray(const std::string& label, GLenum internalFormat, int width, int height, int layers);
     static void destroy(GLuint name) { glDeleteTextures(1, &name); }
+    // A view of `source`'s storage in another format of its view class
+    // (glTextureView: e.g. RGB9_E5 as R32UI for image stores). Owns no bytes.
+    static Texture createView(const std::string& label, const Texture& source, GLenum internalFormat);
     // Takes ownership of an existing texture name (labels it, tracks its bytes).
     static Texture adoptTexture(GLuint name, const std::string& label, GLenum internalFormat, int width, int height,
                                 int layers, int levels);
@@ -92,8 +100,16 @@ public:
     GLint uniform(const char* name) const { return glGetUniformLocation(name_, name); }
 };
 
-// Bytes per texel of the internal formats the engine uses.
-int bytesPerTexel(GLenum internalFormat);
+// Bytes per texel of a texture's level 0, as GL reports its component sizes.
+int64_t bytesPerTexel(GLuint texture);
+
+// Reads (writes) the region (x, y, z) + (width, height, depth) of `texture`'s
+// level 0 as `format`/`type` of `texelBytes` bytes per texel, in calls of at
+// most 256 MiB: no GLsizei byte count can overflow, whatever the page size.
+void readTexture(GLuint texture, int x, int y, int z, int width, int height, int depth, GLenum format, GLenum type,
+                 int texelBytes, void* pixels);
+void writeTexture(GLuint texture, int x, int y, int z, int width, int height, int depth, GLenum format, GLenum type,
+                  int texelBytes, const void* pixels);
 
 // A debug group for the lifetime of the object (glPushDebugGroup/Pop).
 class DebugGroup {

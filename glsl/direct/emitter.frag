@@ -2,14 +2,15 @@
 // Direct light from an emissive triangle, one of its visibility samples:
 // L_lm += Le * F(x -> triangle) * V(x, sample) / sampleCount, with F the exact
 // polygon form factor (no 1/r^2 noise near the emitter) and V read from the
-// sample's distance cube map. Accumulates into the direct map (rgb).
+// sample's distance cube map. Adds to the direct light's float sums
+// (lib/direct_scratch.glsl).
 #include "shared/bundle_layout.h"
 #include "lib/polygon_irradiance.glsl"
 
 in vec3 vPosition;
 in vec3 vNormal;
 
-layout(binding = BINDING_DIRECT, rgba32f) uniform coherent image2DArray directMap;
+#include "lib/direct_scratch.glsl"
 layout(binding = 0) uniform samplerCube distances;
 uniform vec3 emitterA, emitterB, emitterC;  // world vertices
 uniform vec3 emitterNormal;
@@ -42,6 +43,5 @@ void main() {
     if (dist > stored + distanceBias + footprintPerDistance * dist) return;  // occluded
     float f = polygonFormFactor(x, n, emitterA, emitterB, emitterC);
     ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), page);
-    vec4 s = imageLoad(directMap, texel);
-    imageStore(directMap, texel, vec4(s.rgb + radianceOverSamples * f, 1.0));
+    addDirect(texel, radianceOverSamples * f);
 }

@@ -61,3 +61,29 @@ vec3 decodeRgbe(uint v) {
     vec3 m = vec3(float(v & 255u), float((v >> 8u) & 255u), float((v >> 16u) & 255u));
     return m * exp2(float(int(eb) - 136));
 }
+
+// RGB9E5, the bits of GL_RGB9_E5 (r 0..8, g 9..17, b 18..26, shared exponent
+// 27..31; value = m * 2^(e - 24)), encoded as the GL spec does but with
+// stochastic rounding by u (or nearest). The outgoing radiance map: 4 bytes a
+// texel, sampled (and filtered) as GL_RGB9_E5. NaN -> 0, beyond 65408 saturates.
+uint encodeRgb9e5(vec3 c, vec3 u) {
+#ifdef ROUNDING_NEAREST
+    u = vec3(0.5);
+#endif
+    bvec3 nan = isnan(c);
+    c = clamp(vec3(nan.x ? 0.0 : c.x, nan.y ? 0.0 : c.y, nan.z ? 0.0 : c.z), vec3(0.0), vec3(65408.0));
+    float m = max(c.r, max(c.g, c.b));
+    if (m <= 0.0) return 0u;
+    int e;
+    frexp(m, e);  // m = f * 2^e, f in [0.5, 1): floor(log2 m) = e - 1
+    int ex = max(-16, e - 1) + 16;
+    // rounding up must stay below 2^9 (the spec's nearest-rounding check, widened for u < 1)
+    if (ex < 31 && m * exp2(float(24 - ex)) >= 511.0) ex += 1;
+    uvec3 q = uvec3(min(floor(c * exp2(float(24 - ex)) + u), vec3(511.0)));
+    return q.r | (q.g << 9u) | (q.b << 18u) | (uint(ex) << 27u);
+}
+
+vec3 decodeRgb9e5(uint v) {
+    vec3 m = vec3(float(v & 511u), float((v >> 9u) & 511u), float((v >> 18u) & 511u));
+    return m * exp2(float(int(v >> 27u) - 24));
+}

@@ -1,46 +1,33 @@
 #version 430
-// Resolve: light map L_lm = the stored running mean (cosine-weighted mean of
-// incoming radiance, = E/pi; see update.frag and DESIGN.md Units) + the direct sun
-// and explicit emitter maps.
-// Writes, per texel of every page:
-//   radianceOut: Lo = Le + albedo * L_lm (the next bundle passes read it)
-//   otherwise:   L_lm itself (output)
-// Padding texels take the value of their nearest covered texel (`source`,
-// computed once on the CPU), so bilinear lookups near chart edges stay right:
-// the dilation costs nothing per direction. alpha = 1 where a value exists.
+// Resolve: the light map L_lm = the accumulators' running mean (cosine-weighted
+// mean of incoming radiance, = E/pi; see update.frag and DESIGN.md Units) + the
+// direct map (sun and explicit emitters), padding dilated (lib/dilation.glsl);
+// alpha = 1 where a value exists. Writes the region of `pageSize` texels at
+// `origin` (x, y, page) of the light maps to `target` at (0, 0, 0): the whole
+// array (the viewer) or a band of one page (read-backs).
+#include "shared/bundle_layout.h"
+#include "lib/dilation.glsl"
+#include "lib/rounding.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(binding = 1, rg32ui) uniform readonly uimage2DArray accum;
-layout(binding = 2, rgba32f) uniform readonly image2DArray sunMap;
-layout(binding = 3, rgba16f) uniform readonly image2DArray albedoMap;    // a = coverage
-layout(binding = 4, rgba16f) uniform readonly image2DArray emissionMap;
-layout(binding = 5, rgba32f) uniform writeonly image2DArray target;
-layout(binding = 6, r32i) uniform readonly iimage2DArray source;         // x | y << 16 of the texel to copy, or -1
-layout(binding = 7, rgba32f) uniform readonly image2DArray emitterMap;  // explicit direct light from emitters (L_lm)
-
-uniform bool radianceOut;
-uniform bool includeEmission;  // false when emitters are lit explicitly: bundles then carry reflected light only
-uniform int pageCount;
-uniform ivec2 pageSize;
-
-float h2f(uint h) { return unpackHalf2x16(h & 0xFFFFu).x; }
+layout(binding = BINDING_ACCUM, rg32ui) uniform readonly uimage2DArray accum;
+layout(binding = BINDING_DIRECT, rgba16f) uniform readonly image2DArray directMap;
+layout(binding = BINDING_DILATION, r8ui) uniform readonly uimage2DArray dilation;
+layout(binding = BINDING_TARGET, rgba32f) uniform writeonly image2DArray target;
+uniform ivec3 origin;
+uniform int pageCount;   // of the region
+uniform ivec2 pageSize;  // of the region
 
 void main() {
-    ivec3 t = ivec3(gl_GlobalInvocationID.xy, gl_GlobalInvocationID.z);
-    if (t.x >= pageSize.x || t.y >= pageSize.y || t.z >= pageCount) return;
-    int packedSource = imageLoad(source, t).r;
-    if (packedSource < 0) {
-        imageStore(target, t, vec4(0.0));
+    ivec3 g = ivec3(gl_GlobalInvocationID.xy, gl_GlobalInvocationID.z);
+    if (g.x >= pageSize.x || g.y >= pageSize.y || g.z >= pageCount) return;
+    ivec3 t = g + origin;
+    ivec3 s = dilationSource(imageLoad(dilation, t).r, t);
+    if (s.x < 0) {
+        imageStore(target, g, vec4(0.0));
         return;
     }
-    ivec3 s = ivec3(packedSource & 0xFFFF, packedSource >> 16, t.z);
     uvec2 p = imageLoad(accum, s).rg;
-    float w = h2f(p.y >> 16u);
-    vec3 l = w > 0.0 ? vec3(h2f(p.x), h2f(p.x >> 16u), h2f(p.y)) : vec3(0.0);  // the running mean
-    vec4 sun = imageLoad(sunMap, s);  // rgb: sum over valid sun samples, a: their count
-    if (sun.a > 0.0) l += sun.rgb / sun.a;
-    l += imageLoad(emitterMap, s).rgb;
-    vec3 emission = includeEmission ? imageLoad(emissionMap, s).rgb : vec3(0.0);
-    vec3 value = radianceOut ? emission + imageLoad(albedoMap, s).rgb * l : l;
-    imageStore(target, t, vec4(value, 1.0));
+    vec3 l = halfToFloat(p.y >> 16u) > 0.0 ? vec3(halfToFloat(p.x), halfToFloat(p.x >> 16u), halfToFloat(p.y)) : vec3(0.0);
+    imageStore(target, g, vec4(l + imageLoad(directMap, s).rgb, 1.0));
 }

@@ -16,7 +16,8 @@
 //
 // SUN_PASS (define): the same walk along the sun's direction; a texel facing
 // the sun adds (nothing in front ? irradiance * cos / pi : 0) to the direct
-// sun map's rgb and 1 to its alpha (exact shadow test, no noise).
+// light's float sums (lib/direct_scratch.glsl) and 1 to its sample count (the
+// direct map's alpha; direct_fold.comp divides): an exact shadow test, no noise.
 #include "shared/bundle_layout.h"
 #include "lib/rounding.glsl"
 #include "lib/bundle_frame.glsl"
@@ -29,7 +30,8 @@ flat in uint vPage;
 layout(binding = BINDING_HEADS, r32ui) uniform readonly uimage2D heads;
 layout(std430, binding = BINDING_NODES) readonly buffer Nodes { Node nodes[]; };
 #ifdef SUN_PASS
-layout(binding = BINDING_SUN, rgba32f) uniform coherent image2DArray sunMap;
+#include "lib/direct_scratch.glsl"
+layout(binding = BINDING_DIRECT, rgba16f) uniform coherent image2DArray directMap;
 uniform vec3 sunIrradiance;
 #else
 layout(binding = BINDING_ACCUM, rg32ui) uniform coherent uimage2DArray accum;
@@ -136,11 +138,11 @@ void main() {
 
 #ifdef SUN_PASS
     // the sun pass's d is the light's travel direction: a texel facing the sun looks along -d
-    // a valid sample: rgb += lit irradiance * cos / pi, a += 1 (resolve divides)
+    // a valid sample: sums += lit irradiance * cos / pi, count += 1 (exact in fp16 to 2048)
     if (ahead) return;
-    vec4 s = imageLoad(sunMap, texel);
-    vec3 lit = bestNode == END_OF_LIST ? sunIrradiance * (-c) / PI : vec3(0.0);
-    imageStore(sunMap, texel, vec4(s.rgb + lit, s.a + 1.0));
+    addDirect(texel, bestNode == END_OF_LIST ? sunIrradiance * (-c) / PI : vec3(0.0));
+    vec4 d = imageLoad(directMap, texel);
+    imageStore(directMap, texel, vec4(d.rgb, d.a + 1.0));
 #else
     vec3 incoming;
     if (bestNode == END_OF_LIST) {

@@ -28,11 +28,21 @@ struct Node {
 #define BINDING_VERTICES 2       // SSBO: the bake vertices (BakeVertex, 48 bytes), read by the bundle pass
 #define BINDING_HEADS 0          // image unit: r32ui head pointers of the tile
 #define BINDING_ACCUM 1          // image unit: rg32ui accumulators (packed fp16 RGB + W), array of pages
-#define BINDING_SUN 2            // image unit: rgba32f direct sun L_lm, array of pages
-#define BINDING_DIRECT 2         // image unit: rgba32f explicit emitter L_lm (the emitter pass; same unit as the sun's)
-#define BINDING_RADIANCE 0       // texture unit: rgba16f outgoing radiance Lo per texel, array of pages
+#define BINDING_DIRECT 2         // image unit: rgba16f direct light L_lm (sun + emitters); a: the sun's sample count while it is baked
+#define BINDING_SCRATCH_RG 3     // image unit: rg32f view of the accumulators: direct light sums (r, g) while it is baked
+#define BINDING_SCRATCH_B 4      // image unit: r32f view of the radiance map: direct light sums (b) while it is baked
+#define BINDING_RADIANCE_BITS 5  // image unit: r32ui view of the radiance map (RGB9E5 bits), written by the outgoing pass
+#define BINDING_DILATION 6       // image unit: r8ui per texel: DILATION_SELF, the covered texel it copies, or DILATION_NONE
+#define BINDING_TARGET 7         // image unit: rgba32f light map L_lm (the resolve's output)
+#define BINDING_RADIANCE 0       // texture unit: RGB9_E5 outgoing radiance Lo per texel, array of pages
 #define BINDING_ENV 1            // texture unit: environment map (equirectangular)
-#define BINDING_MATERIAL_TEX 2   // texture unit: a material's albedo / emission texture
+#define BINDING_MATERIAL_TEX 2   // texture unit: a material's albedo texture (emission: + 1)
+
+// Dilation codes (r8ui): the covered texel whose value an uncovered one shows,
+// at offset (code & 15, code >> 4) - DILATION_RADIUS; a covered texel shows itself.
+#define DILATION_RADIUS 7
+#define DILATION_SELF 119u        // offset (0, 0)
+#define DILATION_NONE 255u        // no covered texel within the radius
 
 #ifdef __cplusplus
 }  // namespace bb::shared

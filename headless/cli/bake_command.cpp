@@ -36,7 +36,7 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
     cmd.add_option("--culling", a.culling, "Per-tile cluster culling in the bundle and update passes: on or off")
         ->check(CLI::IsMember({"on", "off"}))
         ->capture_default_str();
-    cmd.add_option("--memory-budget", a.memoryBudget, "GPU bytes for one tile's node buffer and head image (e.g. 512M, 2G)")
+    cmd.add_option("--memory-budget", a.memoryBudget, "GL bytes for the whole bake: light maps, mesh, materials, and the rest for the bundle pass (e.g. 1G, 4G)")
         ->capture_default_str();
     cmd.add_option("--seed", a.seed, "Random seed (directions, stochastic rounding)")->capture_default_str();
     cmd.add_option("--sky", a.sky, "Uniform sky radiance r,g,b (scene units)")->capture_default_str();

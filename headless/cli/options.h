@@ -37,7 +37,7 @@ struct BakeArgs {
     int bundleRes = 0;                // 0 = from the layout's texel density
     std::string tiling = "adaptive";  // adaptive | uniform
     std::string culling = "on";       // on | off
-    std::string memoryBudget = "512M";
+    std::string memoryBudget = "4G";
     uint64_t seed = 1;
     std::string sky = "0,0,0";
     std::string env;

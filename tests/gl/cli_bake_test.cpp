@@ -153,8 +153,17 @@ TEST(CliBake, SuccessWritesCompleteOutputsAndNoTempFiles) {
     // fragments per second
     EXPECT_GT(number("/throughput/fragments"), 0.0);
     EXPECT_GT(number("/throughput/fragments_per_second_bundle_pass"), 0.0);
-    // bytes per texel and per node (DESIGN.md: 8 and 12)
-    EXPECT_EQ(number("/memory/bytes_per_lightmap_texel"), 8);
+    // light-map state per page texel, as GL reports the textures' component
+    // sizes: fp16 RGBW accumulator 8 + RGB9E5 radiance 4 + fp16 direct 8 + dilation 1
+    EXPECT_EQ(number("/memory/lightmap_bytes_per_page_texel"), 21.0);
+    EXPECT_EQ(number("/memory/lightmap_state_bytes"), 21.0 * 16 * 16);
+    EXPECT_EQ(number("/memory/by_category/light maps/peak_bytes"), 21.0 * 16 * 16);
+    EXPECT_GE(number("/memory/lightmap_bytes_per_covered_texel"), 21.0);
+    // every category's peak is part of the whole's
+    double sum = 0;
+    for (const auto& [name, c] : stats["memory"]["by_category"].items()) sum += c["peak_bytes"].get<double>();
+    EXPECT_GE(sum, number("/memory/peak_gpu_bytes"));
+    EXPECT_LE(number("/memory/peak_gpu_bytes"), number("/memory/budget_bytes"));
     EXPECT_EQ(number("/memory/bytes_per_node"), 12);
 }
 

@@ -20,7 +20,7 @@ TEST(BundleOverflow, SmallNodeBufferSplitsAndRedrawsWithoutLosingFragments) {
     BakeOptions tight = roomy;
     // head image: 64 x 64 x 4 B = 16 KiB (the smallest tile); nodes: 1200 x 12 B.
     // One direction of the 64-texel furnace has about 5000 fragments.
-    tight.memoryBudget = 64 * 64 * 4 + 1200 * 12;
+    tight.bundleMemory = 64 * 64 * 4 + 1200 * 12;
     tight.predictTiles = false;  // no pre-splitting: only the atomic counter can save the fragments
 
     auto a = test::makeBake("assets/furnace/furnace.gltf", test::assetLayout(64), roomy);

@@ -82,7 +82,7 @@ TEST(TilingBake, TinyBudgetGivesTheSameBits) {
     const Baked roomy = bakeCity(city, cityOptions());
     ASSERT_TRUE(roomy.error.empty()) << roomy.error;
     BakeOptions tightOptions = cityOptions();
-    tightOptions.memoryBudget = 64 * 64 * 4 + 3000 * 12;
+    tightOptions.bundleMemory = 64 * 64 * 4 + 3000 * 12;
     const Baked tight = bakeCity(city, tightOptions);
     ASSERT_TRUE(tight.error.empty()) << tight.error;
     tightOptions.predictTiles = false;
@@ -112,7 +112,7 @@ TEST(TilingBake, CullingChangesNothing) {
     const std::string city = generateCity("culling", "--seed 6");
     ASSERT_FALSE(city.empty()) << "scripts/generate_city.py failed";
     BakeOptions o = cityOptions();
-    o.memoryBudget = 1 << 20;  // several tiles per direction, so there is something to cull
+    o.bundleMemory = 1 << 20;  // several tiles per direction, so there is something to cull
     const Baked on = bakeCity(city, o);
     ASSERT_TRUE(on.error.empty()) << on.error;
     o.cull = false;
@@ -135,7 +135,7 @@ TEST(TilingBake, SteppingByTileGivesTheSameBits) {
     const std::string city = generateCity("steps", "--seed 4");
     ASSERT_FALSE(city.empty()) << "scripts/generate_city.py failed";
     BakeOptions o = cityOptions();
-    o.memoryBudget = 1 << 20;
+    o.bundleMemory = 1 << 20;
     const Baked whole = bakeCity(city, o);
     ASSERT_TRUE(whole.error.empty()) << whole.error;
 
@@ -172,7 +172,7 @@ TEST(TilingBake, PredictionHoldsOnThreeSizes) {
         const std::string city = generateCity(s.name, s.flags);
         ASSERT_FALSE(city.empty()) << "scripts/generate_city.py failed for " << s.flags;
         BakeOptions o = cityOptions();
-        o.memoryBudget = 1 << 20;
+        o.bundleMemory = 1 << 20;
         const Baked b = bakeCity(city, o);
         ASSERT_TRUE(b.error.empty()) << b.error;
         std::vector<double> r = b.stats.predictedOverActual;
