@@ -371,7 +371,7 @@ void Viewer::handleInput(double dt) {
         if (ImGui::IsKeyPressed(GLFW_KEY_T)) settings_.tileOverlay = !settings_.tileOverlay;
         for (int k = 0; k < 9 && k < int(loaded_.scene.cameras.size()); ++k)
             if (ImGui::IsKeyPressed(GLFW_KEY_1 + k)) {
-                useSceneCamera(camera_, loaded_.scene.cameras[size_t(k)], baker_->mesh().bounds);
+                useSceneCamera(camera_, cameraInLocalSpace(loaded_.scene.cameras[size_t(k)], baker_->mesh().origin), baker_->mesh().bounds);
                 cameraChoice_ = k;
             }
     }
@@ -471,7 +471,7 @@ void Viewer::drawPanel() {
             for (size_t c = 0; c < loaded_.scene.cameras.size(); ++c)
                 if (ImGui::Selectable((std::to_string(c + 1) + ": " + loaded_.scene.cameras[c].name).c_str(),
                                       cameraChoice_ == int(c))) {
-                    useSceneCamera(camera_, loaded_.scene.cameras[c], baker_->mesh().bounds);
+                    useSceneCamera(camera_, cameraInLocalSpace(loaded_.scene.cameras[c], baker_->mesh().origin), baker_->mesh().bounds);
                     cameraChoice_ = int(c);
                 }
             ImGui::EndCombo();
@@ -551,11 +551,11 @@ int Viewer::run() {
         return cli::fail("--camera " + std::to_string(args_.camera) + ": the scene has " +
                          std::to_string(loaded_.scene.cameras.size()) + " camera(s)");
     if (args_.camera >= 0) {
-        useSceneCamera(camera_, loaded_.scene.cameras[size_t(args_.camera)], baker_->mesh().bounds);
+        useSceneCamera(camera_, cameraInLocalSpace(loaded_.scene.cameras[size_t(args_.camera)], baker_->mesh().origin), baker_->mesh().bounds);
         cameraChoice_ = args_.camera;
     } else {
         if (!loaded_.scene.cameras.empty()) {
-            useSceneCamera(camera_, loaded_.scene.cameras[0], baker_->mesh().bounds);
+            useSceneCamera(camera_, cameraInLocalSpace(loaded_.scene.cameras[0], baker_->mesh().origin), baker_->mesh().bounds);
         } else {
             camera_.setForward(DEFAULT_FRAMING_DIRECTION);
         }

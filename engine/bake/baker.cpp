@@ -89,6 +89,7 @@ nlohmann::json BakeStats::toJson() const {
     for (const auto& [name, bytes] : peakGpuBytesByCategory)
         categories[name] = {{"peak_bytes", bytes}, {"bytes_per_page_texel", double(bytes) / pageTexels}};
     j["memory"] = {{"budget_bytes", memoryBudget}, {"peak_gpu_bytes", peakGpuBytes},
+                   {"peak_resident_bytes", peakResidentBytes()},
                    {"peak_gpu_bytes_per_page_texel", double(peakGpuBytes) / pageTexels},
                    {"lightmap_state_bytes", lightmapStateBytes},
                    {"lightmap_bytes_per_page_texel", double(lightmapStateBytes) / pageTexels},
@@ -402,6 +403,7 @@ Status Baker::Impl::init(const Scene& scene) {
     }
     {
         // the bundle pass: its buffers start small and grow to what the tiles predict
+        MemoryCategory category("bundles");
         const BundleScene scene{&mesh, &clusters, vao.id(), vertexBuffer.id(), triangleBuffer.id(), radiance.id(),
                                 pageFbo.id(), res};
         const BundleLimits limits{nodeCapacity, maxTileSize, subpixelBits, options.predictTiles};
@@ -515,8 +517,9 @@ BakeProgress Baker::progress() const {
 LightmapPages Baker::readLightmaps() {
     Impl& m = *impl_;
     const int res = m.layout.resolution;
-    // resolved band by band (at most 64 MiB of GL memory)
-    const int rows = std::clamp(int((int64_t(64) << 20) / (int64_t(res) * 16)), 1, res);
+    // resolved band by band: at most 64 MiB of GL memory, and what the budget leaves
+    const int64_t room = std::min<int64_t>(int64_t(64) << 20, m.options.memoryBudget - MemoryTracker::gpu().current());
+    const int rows = int(std::clamp<int64_t>(room / (int64_t(res) * 16), 1, res));
     gl::Texture band;
     {
         MemoryCategory category("read-back");

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include <sys/resource.h>
+
 namespace bb {
 namespace {
 thread_local const char* tCategory = "other";
@@ -40,6 +42,12 @@ void MemoryTracker::resetPeak() {
 std::map<std::string, MemoryTracker::Figures> MemoryTracker::categories() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return categories_;
+}
+
+int64_t peakResidentBytes() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return int64_t(u.ru_maxrss) * 1024;  // KiB on Linux
 }
 
 MemoryCategory::MemoryCategory(const char* name) : previous_(tCategory) { tCategory = name; }

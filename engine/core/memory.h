@@ -36,6 +36,9 @@ private:
     std::map<std::string, Figures> categories_;
 };
 
+// The process's peak resident set (getrusage), bytes.
+int64_t peakResidentBytes();
+
 // GPU allocations made while it lives are filed under `name` (a string literal).
 class MemoryCategory {
 public:

@@ -108,7 +108,7 @@ int runBake(const BakeArgs& args) {
         if (Status s = (*baker)->loadCheckpoint(checkpoint); !s) return fail(s.message());
         logInfo("resuming from " + checkpoint + " at direction " + std::to_string((*baker)->progress().directionsDone));
     }
-    ProgressBar bar(args.progress && isatty(STDERR_FILENO));
+    ProgressBar bar(args.progress, isatty(STDERR_FILENO));
     auto t0 = std::chrono::steady_clock::now();
     int lastCheckpoint = (*baker)->progress().directionsDone;
     while (true) {
@@ -133,8 +133,10 @@ int runBake(const BakeArgs& args) {
                      {"direct", args.direct}, {"emitter_samples", args.emitterSamples}};
     info.wallSeconds = seconds;
     info.writePreviews = args.preview;
-    if (Status s = writeBakeOutputs(args.outDir, loaded->scene, loaded->layout, (*baker)->readLightmaps(),
-                                    (*baker)->stats().toJson(), info); !s) return fail(s.message());
+    LightmapPages maps = (*baker)->readLightmaps();  // before the stats: its read-back memory counts
+    if (Status s = writeBakeOutputs(args.outDir, loaded->scene, loaded->layout, maps, (*baker)->stats().toJson(), info);
+        !s)
+        return fail(s.message());
     if (args.checkpointEvery > 0 || args.resume) std::filesystem::remove(checkpoint);  // the outputs supersede it
     logInfo("baked " + std::to_string(options.directions) + " directions in " + std::to_string(seconds) + " s -> " +
             args.outDir);

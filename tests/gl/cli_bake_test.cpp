@@ -76,6 +76,29 @@ TEST(CliBakeErrors, UnwritableOutputDir) {
     EXPECT_EQ(readFileBytes(file), "x");
 }
 
+// A budget that cannot hold the light maps: one error line naming the sizes
+// and the flag, no outputs; the same bake fits a budget just above its need.
+TEST(CliBakeErrors, MemoryBudgetTooSmallForTheLightMaps) {
+    TempDir tmp("budget");
+    ASSERT_TRUE(tmp.ok());
+    // 512^2 page texels x 21 bytes = 5.25 MiB of light-map state
+    const std::vector<std::string> bake = {"bake", furnace(), "--backend", "osmesa", "--uv-layout", "asset",
+                                           "--resolution", "512", "--directions", "2", "--no-progress", "--no-preview"};
+    auto with = [&](std::vector<std::string> args, const std::string& out, const std::string& budget) {
+        args.insert(args.end(), {"-o", out, "--memory-budget", budget});
+        return args;
+    };
+    CliResult r = runCli(with(bake, tmp / "small", "4M"), tmp);
+    expectOneErrorLine(r, "--memory-budget");
+    EXPECT_NE(r.err.find("light maps take 6 MiB"), std::string::npos) << r.err;
+    EXPECT_EQ(filesIn(tmp.path() / "small"), 0u) << "nothing may be written when the bake does not fit";
+    CliResult ok = runCli(with(bake, tmp / "fits", "32M"), tmp);
+    EXPECT_EQ(ok.exitCode, 0) << ok.err;
+    nlohmann::json stats = nlohmann::json::parse(readFileBytes(tmp / "fits/stats.json"), nullptr, false);
+    ASSERT_FALSE(stats.is_discarded());
+    EXPECT_LE(stats["memory"]["peak_gpu_bytes"].get<double>(), 32.0 * (1 << 20));
+}
+
 TEST(CliBake, SuccessWritesCompleteOutputsAndNoTempFiles) {
     TempDir tmp("success");
     ASSERT_TRUE(tmp.ok());

@@ -1,0 +1,98 @@
+// The outgoing radiance map's RGB9E5 encoder (glsl/lib/rounding.glsl), written
+// through an r32ui view and read back as GL decodes GL_RGB9_E5: its bits are
+// GL's, nearest rounding stays within half a step, special values are safe,
+// and stochastic rounding is unbiased.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "gl/objects.h"
+#include "gl/shader.h"
+#include "support/gl_fixture.h"
+
+namespace bb {
+namespace {
+
+// Encodes values[i] with u[i] on the GPU; returns GL's decoding and the bits.
+void encode(const std::vector<glm::vec4>& values, std::vector<glm::vec3>& decoded, std::vector<uint32_t>& bits) {
+    auto program = gl::buildProgram({"test/rgb9e5.comp"});
+    ASSERT_TRUE(program) << program.error();
+    const int n = int(values.size()), width = 256, height = (n + width - 1) / width;
+    gl::Texture tex = gl::Texture::create2D("rgb9e5 test", GL_RGB9_E5, width, height);
+    gl::Texture view = gl::Texture::createView("rgb9e5 test bits", tex, GL_R32UI);
+    gl::Buffer in = gl::Buffer::create("rgb9e5 test values", int64_t(n) * 16, values.data(), 0);
+    glUseProgram(program->id());
+    glUniform1i(program->uniform("count"), n);
+    glUniform1i(program->uniform("width"), width);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, in.id());
+    glBindImageTexture(0, view.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32UI);
+    glDispatchCompute(GLuint(n + 63) / 64, 1, 1);
+    glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+    std::vector<glm::vec3> all(size_t(width) * height);
+    std::vector<uint32_t> allBits(all.size());
+    gl::readTexture(tex.id(), 0, 0, 0, width, height, 1, GL_RGB, GL_FLOAT, 12, all.data());
+    gl::readTexture(view.id(), 0, 0, 0, width, height, 1, GL_RED_INTEGER, GL_UNSIGNED_INT, 4, allBits.data());
+    decoded.assign(all.begin(), all.begin() + n);
+    bits.assign(allBits.begin(), allBits.begin() + n);
+    EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR));
+}
+
+float step(uint32_t bits) { return std::ldexp(1.0f, int(bits >> 27) - 24); }
+
+TEST(Rgb9e5, NearestRoundingWithinHalfAStepAndSpecialValuesSafe) {
+    BB_REQUIRE_GL();
+    const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+    std::vector<glm::vec3> v = {{0, 0, 0},       {1e-9f, 0, 0},     {1e-5f, 2e-5f, 3e-5f}, {0.1f, 0.2f, 0.3f},
+                                {1, 1, 1},       {0.9f, 0.01f, 0.5f}, {1000, 3, 0.25f},    {65000, 1, 0},
+                                {511.9f, 0, 0},  {1e6f, 1, 1},      {inf, 1, 1},          {nan, 1, 2},
+                                {-1, 0.5f, 0.5f}};
+    for (int i = 0; i < 200; ++i) v.push_back(glm::vec3(std::ldexp(1.37f, i / 8 - 12), 0.73f * float(i % 7), 1e-3f * float(i)));
+    std::vector<glm::vec4> in;
+    for (const glm::vec3& c : v) in.push_back(glm::vec4(c, 0.5f));
+    std::vector<glm::vec3> out;
+    std::vector<uint32_t> bits;
+    encode(in, out, bits);
+    ASSERT_EQ(out.size(), v.size());
+    for (size_t i = 0; i < v.size(); ++i) {
+        // GL's decoding of the bits is m * 2^(e - 24): the encoder writes GL's layout
+        const glm::vec3 m(float(bits[i] & 511u), float((bits[i] >> 9) & 511u), float((bits[i] >> 18) & 511u));
+        ASSERT_EQ(out[i], m * step(bits[i])) << "texel " << i;
+        for (int c = 0; c < 3; ++c) {
+            float x = v[i][c];
+            float expected = std::isnan(x) ? 0.0f : std::clamp(x, 0.0f, 65408.0f);
+            EXPECT_LE(std::abs(out[i][c] - expected), 0.5f * step(bits[i]) * 1.0001f)
+                << "value " << i << " channel " << c << " input " << x << " got " << out[i][c];
+        }
+    }
+    // the largest channel keeps 9 bits: relative error at most 2^-9 (one step over 256)
+    for (size_t i = 0; i < v.size(); ++i) {
+        float mx = std::max({out[i].r, out[i].g, out[i].b});
+        if (mx > 1e-4f && mx < 65000.0f) EXPECT_GE(mx / step(bits[i]), 255.5f) << "value " << i;
+    }
+}
+
+TEST(Rgb9e5, StochasticRoundingIsUnbiased) {
+    BB_REQUIRE_GL();
+    // one value, 4096 stratified u: the mean decodes to the value (within 1/4096 of a step)
+    const glm::vec3 value(0.3f, 0.0123f, 7.7f);
+    const int n = 4096;
+    std::vector<glm::vec4> in;
+    for (int i = 0; i < n; ++i) in.push_back(glm::vec4(value, (float(i) + 0.5f) / float(n)));
+    std::vector<glm::vec3> out;
+    std::vector<uint32_t> bits;
+    encode(in, out, bits);
+    glm::dvec3 sum(0.0);
+    for (const glm::vec3& o : out) sum += glm::dvec3(o);
+    const glm::dvec3 mean = sum / double(n);
+    const double s = step(bits[0]);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(mean[c], value[c], 2.0 * s / n + 1e-7 * value[c]) << "channel " << c;
+    // and it does round both ways (0.0123 sits between two steps far apart relative to it)
+    EXPECT_NE(out.front().g, out.back().g);
+}
+
+}  // namespace
+}  // namespace bb
