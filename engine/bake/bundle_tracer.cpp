@@ -29,12 +29,16 @@ void setFrameUniforms(GLuint program, const TileFrame& f) {
 Expected<std::unique_ptr<BundleTracer>> BundleTracer::create(const BundleScene& scene, const BundleLimits& limits,
                                                              const std::string& defines, BakeStats* stats) {
     std::unique_ptr<BundleTracer> t(new BundleTracer());
+    if (Status drawable = checkMeshDrawable(int64_t(scene.mesh->triangleCount())); !drawable) return drawable;
     auto program = gl::buildProgram({"bundle/append.vert", "bundle/append.frag"}, defines);
     if (!program) return program.status();
     t->append_ = std::move(program.value());
     t->scene_ = scene;
     t->limits_ = limits;
     t->stats_ = stats;
+    t->chunks_ = MeshChunks::create(int64_t(scene.mesh->triangleCount()),
+                                    {{MESH_BINDING_TRIANGLES, scene.triangleBuffer, int64_t(sizeof(BakeTriangle))},
+                                     {BINDING_VERTICES, scene.vertexBuffer, 3 * int64_t(sizeof(BakeVertex))}});
     t->counter_ = gl::Buffer::create("bundle node counter", 4, nullptr, GL_DYNAMIC_STORAGE_BIT);
     t->ensureNodes(limits.predict ? std::min<int64_t>(limits.nodeCapacity, 1 << 16) : limits.nodeCapacity);
     t->ensureHeads(64);
@@ -66,11 +70,11 @@ void BundleTracer::ensureHeads(int side) {
     stats_->headImageBytes = std::max<int64_t>(stats_->headImageBytes, heads_.bytes());
 }
 
-void BundleTracer::drawClusters(const std::vector<uint32_t>& ids, bool receiversOnly) {
-    // the update pass draws only triangles with texel centres (receivers first in each cluster)
+void BundleTracer::drawClusters(GLuint program, const std::vector<uint32_t>& ids, bool receiversOnly) {
+    // the update pass draws only triangles with texel centres (receivers first in each cluster);
+    // int32 vertex ranges hold: create() checked the mesh against GLint firsts
     clusterRanges(*scene_.clusters, ids, drawFirst_, drawCount_, receiversOnly);
-    if (!drawFirst_.empty())
-        glMultiDrawArrays(GL_TRIANGLES, drawFirst_.data(), drawCount_.data(), GLsizei(drawFirst_.size()));
+    chunks_.multiDrawArrays(program, drawFirst_, drawCount_);
     int64_t triangles = 0;
     for (int32_t c : drawCount_) triangles += c / 3;
     if (recordStats_) (receiversOnly ? stats_->updateTrianglesDrawn : stats_->bundleTrianglesDrawn) += triangles;
@@ -118,9 +122,8 @@ void BundleTracer::next(const UpdateFn& update) {
     if (limits_.predict) ensureNodes(int64_t(std::ceil(1.25 * tile.predictedNodes)) + 1024);
     ensureHeads(std::max(tile.window.width, tile.window.height));
 
-    // what both passes read
+    // what both passes read (the mesh's SSBOs: per chunk, in drawClusters)
     glBindVertexArray(scene_.vertexArray);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, scene_.triangleBuffer);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_NODES, nodes_.id());
 
     auto tb = Clock::now();
@@ -144,11 +147,10 @@ void BundleTracer::next(const UpdateFn& update) {
         glViewport(-tile.window.x, -tile.window.y, viewportPixels, viewportPixels);
         glEnable(GL_SCISSOR_TEST);
         glScissor(0, 0, tile.window.width, tile.window.height);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_VERTICES, scene_.vertexBuffer);
         glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, BINDING_NODE_COUNTER, counter_.id());
         glBindImageTexture(BINDING_HEADS, heads_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
         glBindTextureUnit(BINDING_RADIANCE, scene_.radiance);
-        drawClusters(tile.clusters, false);
+        drawClusters(append_.id(), tile.clusters, false);
         glDisable(GL_SCISSOR_TEST);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                         GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
@@ -191,7 +193,7 @@ void BundleTracer::next(const UpdateFn& update) {
             setFrameUniforms(program, f);
             glUniform1ui(glGetUniformLocation(program, "nodeCount"), count);
             glBindImageTexture(BINDING_HEADS, heads_.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
-            drawClusters(tile.clusters, true);
+            drawClusters(program, tile.clusters, true);
             glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
         }
         if (recordStats_) {

@@ -23,6 +23,7 @@
 #include "bake/baker.h"
 #include "core/status.h"
 #include "gl/objects.h"
+#include "layout/bake_mesh_gl.h"
 #include "tiler/tiler.h"
 
 namespace bb {
@@ -64,7 +65,11 @@ public:
     // the node count, which the tracer sets) and returns it; 0 skips the update.
     using UpdateFn = std::function<GLuint(const TileFrame&, uint32_t nodeCount)>;
 
-    // Errors: the bundle program failed to build (one line).
+    // Both passes read the triangle and vertex buffers as SSBOs in chunks of
+    // GL_MAX_SHADER_STORAGE_BLOCK_SIZE (MeshChunks, layout/bake_mesh_gl.h):
+    // the update program declares meshChunkFirstTriangle (lib/bake_vertex.glsl),
+    // which the tracer sets with each chunk's draw.
+    // Errors: the bundle program failed to build; a mesh beyond GLint draw firsts (one line).
     static Expected<std::unique_ptr<BundleTracer>> create(const BundleScene& scene, const BundleLimits& limits,
                                                           const std::string& defines, BakeStats* stats);
 
@@ -93,12 +98,13 @@ private:
     BundleTracer() = default;
     void ensureNodes(int64_t nodes);
     void ensureHeads(int side);
-    void drawClusters(const std::vector<uint32_t>& ids, bool receiversOnly);
+    void drawClusters(GLuint program, const std::vector<uint32_t>& ids, bool receiversOnly);
 
     BundleScene scene_;
     BundleLimits limits_;
     BakeStats* stats_ = nullptr;
     gl::Program append_;
+    MeshChunks chunks_;  // the triangle and vertex SSBOs, bound per chunk
     gl::Buffer nodes_, counter_;
     gl::Texture heads_;
     gl::Framebuffer fbo_;

@@ -60,21 +60,16 @@ Expected<ImportanceGlResult> ImportanceAnalyzer::analyze(const BakeMesh& mesh, i
     ImportanceGlResult result;
 
     // limits (read, not assumed)
-    GLint maxTex = 0, vp[2] = {0, 0}, maxFbW = 0, maxFbH = 0, ssboAlign = 1;
-    GLint64 maxSsbo = 0;
+    GLint maxTex = 0, vp[2] = {0, 0}, maxFbW = 0, maxFbH = 0;
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &maxTex);
     glGetIntegerv(GL_MAX_VIEWPORT_DIMS, vp);
     glGetIntegerv(GL_MAX_FRAMEBUFFER_WIDTH, &maxFbW);
     glGetIntegerv(GL_MAX_FRAMEBUFFER_HEIGHT, &maxFbH);
-    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxSsbo);
-    glGetIntegerv(GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT, &ssboAlign);
     const int maxSide = std::min({maxTex, vp[0], vp[1], maxFbW, maxFbH});
     if (resolution < 1 || resolution > maxSide)
         return Status::error("light map resolution " + std::to_string(resolution) +
                              " exceeds this GL's texture/viewport/framebuffer limit " + std::to_string(maxSide));
-    if (int64_t(n) * 4 > maxSsbo)
-        return Status::error(std::to_string(n) + " triangles exceed GL_MAX_SHADER_STORAGE_BLOCK_SIZE (" +
-                             std::to_string(maxSsbo) + " bytes) for the per-triangle I_max buffer");
+    if (Status drawable = checkMeshDrawable(int64_t(n)); !drawable) return drawable;
     if (capture.positionBuffers && int64_t(resolution) * resolution * 16 > int64_t(INT32_MAX))
         return Status::error("capturing the position buffer of a " + std::to_string(resolution) +
                              "^2 page exceeds one 2 GiB read-back");
@@ -92,6 +87,10 @@ Expected<ImportanceGlResult> ImportanceAnalyzer::analyze(const BakeMesh& mesh, i
     glClearNamedBufferData(maxDensity.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);  // I_max = 0.0f
     importance_ = gl::Buffer::create("importance I(t)", perTriangleBytes, nullptr, 0);
     gl::Buffer ratio = gl::Buffer::create("importance A_l/A_o", perTriangleBytes, nullptr, 0);
+    // the SSBOs each pass reads, bound per chunk of GL_MAX_SHADER_STORAGE_BLOCK_SIZE
+    const MeshChunks positionChunks = MeshChunks::create(int64_t(n), {});  // reads none
+    const MeshChunks maxDensityChunks =
+        MeshChunks::create(int64_t(n), {{IMPORTANCE_BINDING_MAX_DENSITY, maxDensity.id(), 4}});
 
     gl::Texture positions = gl::Texture::create2D("importance position buffer", GL_RGBA32F, resolution, resolution);
     gl::Texture triangles = gl::Texture::create2D("importance triangle buffer", GL_R32UI, resolution, resolution);
@@ -131,7 +130,7 @@ Expected<ImportanceGlResult> ImportanceAnalyzer::analyze(const BakeMesh& mesh, i
             glClearBufferfv(GL_COLOR, IMPORTANCE_OUT_POSITION, zeroF);
             glClearBufferuiv(GL_COLOR, IMPORTANCE_OUT_TRIANGLE, zeroU);
             glUseProgram(positionProgram_.id());
-            if (last > first) glDrawArrays(GL_TRIANGLES, GLint(first * 3), GLsizei((last - first) * 3));
+            positionChunks.drawArrays(positionProgram_.id(), first, int64_t(last) - first);
             glFinish();
         }
         result.seconds.positionPass += secondsSince(t1);
@@ -144,13 +143,12 @@ Expected<ImportanceGlResult> ImportanceAnalyzer::analyze(const BakeMesh& mesh, i
             glUniform1i(maxDensityProgram_.uniform("writeDensity"), capture.texelDensity ? 1 : 0);
             glBindImageTexture(IMPORTANCE_IMAGE_POSITIONS, positions.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
             glBindImageTexture(IMPORTANCE_IMAGE_TRIANGLES, triangles.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
-            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IMPORTANCE_BINDING_MAX_DENSITY, maxDensity.id());
             if (capture.texelDensity) {
                 const float zeroF = 0.0f;
                 glClearTexImage(density.id(), 0, GL_RED, GL_FLOAT, &zeroF);
                 glBindImageTexture(IMPORTANCE_IMAGE_DENSITY, density.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
             }
-            if (last > first) glDrawArrays(GL_TRIANGLES, GLint(first * 3), GLsizei((last - first) * 3));
+            maxDensityChunks.drawArrays(maxDensityProgram_.id(), first, int64_t(last) - first);
             glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT |
                             GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
             glFinish();
@@ -181,28 +179,24 @@ Expected<ImportanceGlResult> ImportanceAnalyzer::analyze(const BakeMesh& mesh, i
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 
     // pass 3: Eq. (4), in chunks so that every bound range fits the SSBO size
-    // limit and the dispatch limit; a chunk is a multiple of the group size,
-    // so its offsets are multiples of 64 * 4 and 64 * 144 bytes
+    // limit and the dispatch limit (clamp.comp indexes from its chunk's first triangle)
     auto t3 = Clock::now();
     {
         gl::DebugGroup pass("importance clamp pass");
         GLint maxGroups = 0;
         glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0, &maxGroups);
-        const int64_t bytesPerTriangle = 3 * int64_t(sizeof(BakeVertex));
-        int64_t chunk = std::min<int64_t>(int64_t(maxGroups) * IMPORTANCE_GROUP_SIZE, maxSsbo / bytesPerTriangle);
-        chunk = std::max<int64_t>(IMPORTANCE_GROUP_SIZE, chunk / IMPORTANCE_GROUP_SIZE * IMPORTANCE_GROUP_SIZE);
-        CHECK_EQ((chunk * 4) % ssboAlign, 0);
+        const MeshChunks chunks =
+            MeshChunks::create(int64_t(n),
+                               {{IMPORTANCE_BINDING_VERTICES, vertices.id(), 3 * int64_t(sizeof(BakeVertex))},
+                                {IMPORTANCE_BINDING_MAX_DENSITY, maxDensity.id(), 4},
+                                {IMPORTANCE_BINDING_IMPORTANCE, importance_.id(), 4},
+                                {IMPORTANCE_BINDING_AREA_RATIO, ratio.id(), 4}},
+                               int64_t(maxGroups) * IMPORTANCE_GROUP_SIZE);
         glUseProgram(clampProgram_.id());
         glUniform1f(clampProgram_.uniform("resolution"), float(resolution));
-        for (int64_t base = 0; base < int64_t(n); base += chunk) {
-            const int64_t count = std::min<int64_t>(chunk, int64_t(n) - base);
-            glBindBufferRange(GL_SHADER_STORAGE_BUFFER, IMPORTANCE_BINDING_VERTICES, vertices.id(),
-                              base * bytesPerTriangle, count * bytesPerTriangle);
-            glBindBufferRange(GL_SHADER_STORAGE_BUFFER, IMPORTANCE_BINDING_MAX_DENSITY, maxDensity.id(), base * 4,
-                              count * 4);
-            glBindBufferRange(GL_SHADER_STORAGE_BUFFER, IMPORTANCE_BINDING_IMPORTANCE, importance_.id(), base * 4,
-                              count * 4);
-            glBindBufferRange(GL_SHADER_STORAGE_BUFFER, IMPORTANCE_BINDING_AREA_RATIO, ratio.id(), base * 4, count * 4);
+        for (int c = 0; c < chunks.chunkCount(); ++c) {
+            const int64_t count = chunks.chunkEnd(c) - chunks.chunkFirst(c);
+            chunks.bind(c, clampProgram_.id());
             glUniform1ui(clampProgram_.uniform("triangleCount"), GLuint(count));
             glDispatchCompute(GLuint((count + IMPORTANCE_GROUP_SIZE - 1) / IMPORTANCE_GROUP_SIZE), 1, 1);
         }

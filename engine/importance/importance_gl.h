@@ -64,9 +64,10 @@ public:
 
     // Runs passes 1-3 over every page of `mesh` (pages of `resolution`
     // texels; BakeMesh::lightmapUv in page space) and reads I(t), A_l/A_o and
-    // I_max(t) back. Errors: resolution above GL_MAX_TEXTURE_SIZE or the
-    // viewport/framebuffer limits; per-triangle buffers above
-    // GL_MAX_SHADER_STORAGE_BLOCK_SIZE (about 33 M triangles on llvmpipe).
+    // I_max(t) back. Per-triangle SSBOs are bound in chunks that fit
+    // GL_MAX_SHADER_STORAGE_BLOCK_SIZE (MeshChunks, layout/bake_mesh_gl.h).
+    // Errors: resolution above GL_MAX_TEXTURE_SIZE or the viewport/framebuffer
+    // limits; more triangles than GLint draw firsts address (checkMeshDrawable).
     Expected<ImportanceGlResult> analyze(const BakeMesh& mesh, int resolution, const ImportanceCapture& capture = {});
 
     // After analyze(): I(t) as one float per triangle (BakeMesh order), kept

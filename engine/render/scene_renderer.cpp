@@ -234,6 +234,7 @@ struct SceneRenderer::Impl {
         uint32_t material = 0;
         uint32_t first = 0;  // index into the index buffer
         uint32_t count = 0;  // indices
+        int chunk = 0;       // of `chunks`: a material's triangles are cut into runs at chunk boundaries
     };
     std::vector<Material> materials;
     std::vector<MaterialRun> runs;
@@ -242,6 +243,7 @@ struct SceneRenderer::Impl {
 
     gl::Buffer vertexBuffer, triangleBuffer, indexBuffer, importanceBuffer, dummyBuffer;
     gl::VertexArray vao;
+    MeshChunks chunks;  // triangles (binding 1), importance (binding 2, once set), bound per chunk
     gl::Program program;
     std::vector<gl::Texture> textures;  // Scene::textures, sRGB8 mipmapped
     gl::Texture ownedLightmap, dummyLightmap, dummyTexture;
@@ -260,6 +262,7 @@ SceneRenderer::~SceneRenderer() = default;
 
 Expected<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const Scene& scene, const BakeMesh& mesh,
                                                                int lightmapResolution) {
+    if (Status drawable = checkMeshDrawable(int64_t(mesh.triangleCount())); !drawable) return drawable;
     auto m = std::make_unique<Impl>();
     m->materials = scene.materials;
     m->triangleCount = mesh.triangleCount();
@@ -280,13 +283,23 @@ Expected<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const Scene& scen
                      [&](uint32_t a, uint32_t b) { return mesh.triangles[a].material < mesh.triangles[b].material; });
     std::vector<uint32_t> indices;
     indices.reserve(order.size() * 3);
-    for (size_t i = 0; i < order.size(); ++i) {
-        const uint32_t t = order[i];
-        if (m->runs.empty() || m->runs.back().material != mesh.triangles[t].material)
-            m->runs.push_back({mesh.triangles[t].material, uint32_t(indices.size()), 0});
-        for (uint32_t k = 0; k < 3; ++k) indices.push_back(t * 3 + k);
-        m->runs.back().count += 3;
+    // the per-triangle SSBOs in chunks of GL_MAX_SHADER_STORAGE_BLOCK_SIZE; a
+    // material's triangles ascend (stable sort), so its run cuts at chunk boundaries
+    m->chunks = MeshChunks::create(int64_t(mesh.triangleCount()),
+                                   {{MESH_BINDING_TRIANGLES, m->triangleBuffer.id(), int64_t(sizeof(BakeTriangle))},
+                                    {2, 0, int64_t(sizeof(float))}});  // importance: setImportance
+    for (size_t begin = 0; begin < order.size();) {
+        const uint32_t material = mesh.triangles[order[begin]].material;
+        size_t end = begin;
+        while (end < order.size() && mesh.triangles[order[end]].material == material) ++end;
+        m->chunks.forEachPiece(std::span<const uint32_t>(order).subspan(begin, end - begin),
+                               [&](int chunk, size_t b, size_t e) {
+                                   m->runs.push_back({material, uint32_t(3 * (begin + b)), uint32_t(3 * (e - b)), chunk});
+                               });
+        begin = end;
     }
+    for (uint32_t t : order)
+        for (uint32_t k = 0; k < 3; ++k) indices.push_back(t * 3 + k);
     m->indexBuffer = gl::Buffer::create("render indices", int64_t(indices.size() * 4), indices.data(), 0);
     m->vao = createBakeVertexArray("render vertex array", m->vertexBuffer);
     glVertexArrayElementBuffer(m->vao.id(), m->indexBuffer.id());
@@ -387,6 +400,7 @@ Status SceneRenderer::setImportance(std::span<const float> perTriangle) {
     Impl& m = *impl_;
     if (perTriangle.empty()) {
         m.importanceBuffer.reset();
+        m.chunks.setBuffer(1, 0);
         m.importanceReady = false;
         return Status::ok();
     }
@@ -401,6 +415,7 @@ Status SceneRenderer::setImportance(std::span<const float> perTriangle) {
     m.importanceLogRange = glm::vec2(mid - half, mid + half);
     m.importanceBuffer = gl::Buffer::create("render importance", int64_t(perTriangle.size() * sizeof(float)),
                                             perTriangle.data(), 0);
+    m.chunks.setBuffer(1, m.importanceBuffer.id());
     m.importanceReady = true;
     return Status::ok();
 }
@@ -453,14 +468,16 @@ void SceneRenderer::draw(const RenderView& view, const RenderSettings& settings,
     }
 
     glBindVertexArray(m.vao.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, m.triangleBuffer.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, m.importanceReady ? m.importanceBuffer.id() : m.dummyBuffer.id());
+    // the mesh's SSBOs: per chunk, below (importance: the placeholder until setImportance)
+    if (!m.importanceReady) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, m.dummyBuffer.id());
     glBindTextureUnit(0, m.lightmapTexture ? m.lightmapTexture : m.dummyLightmap.id());
     glBindSampler(0, m.lightmapSampler.name);
 
     const GLint albedoLoc = m.program.uniform("albedo"), emissionLoc = m.program.uniform("emission");
     const GLint hasAlbedoLoc = m.program.uniform("hasAlbedoTexture"), hasEmissionLoc = m.program.uniform("hasEmissionTexture");
+    int boundChunk = -1;
     for (const Impl::MaterialRun& run : m.runs) {
+        if (run.chunk != boundChunk) m.chunks.bind(boundChunk = run.chunk, p);
         const Material& mat = m.materials[run.material];
         if (mat.doubleSided)
             glDisable(GL_CULL_FACE);
@@ -475,7 +492,7 @@ void SceneRenderer::draw(const RenderView& view, const RenderSettings& settings,
         glBindTextureUnit(1, hasAlbedo ? m.textures[size_t(mat.albedoTexture)].id() : m.dummyTexture.id());
         glBindTextureUnit(2, hasEmission ? m.textures[size_t(mat.emissionTexture)].id() : m.dummyTexture.id());
         glDrawElements(GL_TRIANGLES, GLsizei(run.count), GL_UNSIGNED_INT,
-                       reinterpret_cast<const void*>(size_t(run.first) * sizeof(uint32_t)));
+                       reinterpret_cast<const void*>(uintptr_t(int64_t(run.first) * int64_t(sizeof(uint32_t)))));
     }
 
     // the state the Baker assumes (it sets it once at creation)

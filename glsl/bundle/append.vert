@@ -7,7 +7,8 @@
 uniform int viewportPixels;   // the viewport's side: a power of two >= leafPixels
 uniform float subpixelSteps;  // 2^GL_SUBPIXEL_BITS
 
-// The whole triangle, for the plane equations below.
+// The whole triangle, for the plane equations below (bound in chunks, as
+// triangles[]: vertex 3t + k of the mesh is vertices[3 (t - meshChunkFirstTriangle) + k]).
 layout(std430, binding = BINDING_VERTICES) readonly buffer Vertices { BakeVertex vertices[]; };
 
 // Depth and light map uv as planes over the leaf's pixel grid: value =
@@ -33,6 +34,7 @@ vec3 plane(vec2 p0, vec2 p1, vec2 p2, float a0, float a1, float a2, float det) {
 
 void main() {
     uint t = uint(gl_VertexID) / 3u;
+    uint v0 = 3u * (t - meshChunkFirstTriangle);  // the triangle's first vertex in the bound chunk
     vec3 b = bundleFromWorld(inPosition.xyz);
     // Clip space of the leaf's grid: the viewport (-tileOffset) and a scissor
     // to the tile select the tile. Vertices are snapped to the rasterizer's
@@ -47,13 +49,13 @@ void main() {
     vec3 c[3];
     vec2 p[3];
     for (int k = 0; k < 3; ++k) {
-        c[k] = bundleFromWorld(vertices[3u * t + uint(k)].position.xyz);
+        c[k] = bundleFromWorld(vertices[v0 + uint(k)].position.xyz);
         p[k] = gridFromRoot(rootFromBundle(c[k].xy));  // the true plane, not the snapped one: exact depths
     }
     float det = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[2].x - p[0].x) * (p[1].y - p[0].y);
     if (det != 0.0) {
         vDepthPlane = plane(p[0], p[1], p[2], c[0].z, c[1].z, c[2].z, det);
-        vec2 uv0 = vertices[3u * t].lightmapUv, uv1 = vertices[3u * t + 1u].lightmapUv, uv2 = vertices[3u * t + 2u].lightmapUv;
+        vec2 uv0 = vertices[v0].lightmapUv, uv1 = vertices[v0 + 1u].lightmapUv, uv2 = vertices[v0 + 2u].lightmapUv;
         vUPlane = plane(p[0], p[1], p[2], uv0.x, uv1.x, uv2.x, det);
         vVPlane = plane(p[0], p[1], p[2], uv0.y, uv1.y, uv2.y, det);
     } else {
@@ -62,7 +64,7 @@ void main() {
         vUPlane = vec3(0.0, 0.0, inLightmapUv.x);
         vVPlane = vec3(0.0, 0.0, inLightmapUv.y);
     }
-    uvec4 tri = triangles[t];
+    uvec4 tri = bakeTriangle(t);
     vPage = tri.y;
     vFlags = tri.w;
     vFaceNormal = inNormal.xyz;

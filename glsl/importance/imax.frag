@@ -11,7 +11,9 @@ flat in uint vTriangle;
 // read as images: on llvmpipe imageLoad is 1.5-2x faster here than texelFetch
 layout(binding = IMPORTANCE_IMAGE_POSITIONS, rgba32f) uniform readonly image2D positions;
 layout(binding = IMPORTANCE_IMAGE_TRIANGLES, r32ui) uniform readonly uimage2D triangleIds;
+// bound one chunk at a time (MeshChunks, as lib/bake_vertex.glsl): triangle t is element t - meshChunkFirstTriangle
 layout(std430, binding = IMPORTANCE_BINDING_MAX_DENSITY) coherent buffer MaxDensity { uint maxDensityBits[]; };
+uniform uint meshChunkFirstTriangle;
 layout(binding = IMPORTANCE_IMAGE_DENSITY, r32f) uniform writeonly image2D densityImage;
 uniform bool writeDensity;  // also store I(x) per texel (checks and figures)
 uniform int resolution;     // page side in texels
@@ -41,6 +43,7 @@ void main() {
     // most fragments of a triangle do not raise its maximum: a plain read
     // first skips their atomics (values only grow, so skipping is safe)
     uint bits = floatBitsToUint(density);
-    if (bits > maxDensityBits[vTriangle]) atomicMax(maxDensityBits[vTriangle], bits);
+    uint t = vTriangle - meshChunkFirstTriangle;
+    if (bits > maxDensityBits[t]) atomicMax(maxDensityBits[t], bits);
     if (writeDensity) imageStore(densityImage, x, vec4(density));
 }

@@ -12,7 +12,7 @@ void main() {
     gl_Position = vec4(inLightmapUv * 2.0 - 1.0, 0.0, 1.0);
     vPosition = inPosition.xyz;
     vNormal = inNormal.xyz;
-    uvec4 tri = triangles[gl_VertexID / 3];
+    uvec4 tri = bakeTriangle(uint(gl_VertexID) / 3u);
     vFlags = tri.w;
     vPage = tri.y;  // one draw covers every page
 }

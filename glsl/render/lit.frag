@@ -16,7 +16,8 @@ layout(location = 0) out vec4 outColor;
 layout(binding = 0) uniform sampler2DArray lightmap;   // rgb = L_lm, one layer per page (bilinear)
 layout(binding = 1) uniform sampler2D albedoTexture;   // TEXCOORD_0, sRGB8 (decoded by GL)
 layout(binding = 2) uniform sampler2D emissionTexture;
-layout(std430, binding = 2) readonly buffer Importance { float importance[]; };  // per triangle
+layout(std430, binding = 2) readonly buffer Importance { float importance[]; };  // per triangle, a chunk (lib/bake_vertex.glsl)
+uniform uint meshChunkFirstTriangle;
 
 uniform vec3 albedo;              // Material::albedo (factor x (1 - metallic))
 uniform vec3 emission;            // Material::emission (radiance)
@@ -65,7 +66,7 @@ void main() {
     } else if (viewMode == VIEW_ALBEDO) {
         display = srgbOetf(a);
     } else if (viewMode == VIEW_IMPORTANCE) {
-        float i = importance[vTriangle];
+        float i = importance[vTriangle - meshChunkFirstTriangle];
         float span = max(importanceLogRange.y - importanceLogRange.x, 1e-6);
         display = i > 0.0 ? heat((log2(i) - importanceLogRange.x) / span) : vec3(0.15);
     } else if (viewMode == VIEW_DENSITY) {

@@ -18,5 +18,5 @@ void main() {
     vUv0 = inUv0;
     vLightmapUv = inLightmapUv;
     vTriangle = uint(gl_VertexID) / 3u;
-    vPage = triangles[vTriangle].y;
+    vPage = bakeTriangle(vTriangle).y;
 }

@@ -5,6 +5,10 @@
 #define TRIANGLE_DOUBLE_SIDED 1u
 #define TRIANGLE_EMISSIVE 2u
 
+// SSBO binding of BakeTriangle triangles[] (lib/bake_vertex.glsl), bound in
+// chunks by MeshChunks (engine/layout/bake_mesh_gl.h)
+#define MESH_BINDING_TRIANGLES 1
+
 #ifndef __cplusplus
 // BakeVertex as std430 sees it: 48 bytes, offsets 0, 16, 32, 40 (the C++
 // struct static_asserts its size in engine/layout/bake_mesh.h).
