@@ -190,8 +190,7 @@ void Baker::Impl::uploadMaterials(const Scene& scene) {
 
 void Baker::Impl::drawSurface(GLuint program, bool materialUniforms) {
     glUseProgram(program);
-    glBindVertexArray(vao.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, triangleBuffer.id());
+    glBindVertexArray(vao.id());  // meta.vert reads attributes only: no per-triangle SSBO to chunk
     glBindFramebuffer(GL_FRAMEBUFFER, pageFbo.id());
     glViewport(0, 0, layout.resolution, layout.resolution);
     const GLint pageUniform = glGetUniformLocation(program, "page");
@@ -588,7 +587,7 @@ Baker::BundleCapture Baker::captureBundle(const glm::vec3& dir) {
     if (cap.width == 0) return cap;  // nothing drawn
     const int headSide = m.tracer->headSide();
     std::vector<uint32_t> heads(size_t(headSide) * headSide);
-    glGetTextureImage(m.tracer->heads().id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, GLsizei(heads.size() * 4), heads.data());
+    gl::readTexture(m.tracer->heads().id(), 0, 0, 0, headSide, headSide, 1, GL_RED_INTEGER, GL_UNSIGNED_INT, 4, heads.data());
     std::vector<shared::Node> nodes(std::max<uint32_t>(cap.nodeCount, 1));
     glGetNamedBufferSubData(m.tracer->nodes().id(), 0, GLsizeiptr(nodes.size() * sizeof(shared::Node)), nodes.data());
     cap.depths.resize(size_t(cap.width) * cap.height);

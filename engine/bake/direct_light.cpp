@@ -10,6 +10,7 @@
 #include "core/check.h"
 #include "core/memory.h"
 #include "gl/gl.h"
+#include "layout/bake_mesh_gl.h"
 #include "glsl/shared/bundle_layout.h"
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -137,7 +138,7 @@ void Baker::Impl::bakeEmitters() {
                 glUniformMatrix4fv(distanceProgram.uniform("clipFromWorld"), 1, GL_FALSE, &clipFromWorld[0][0]);
                 glClearNamedFramebufferfv(fbo.id(), GL_COLOR, 0, &farValue);
                 glClearNamedFramebufferfi(fbo.id(), GL_DEPTH_STENCIL, 0, 1.0f, 0);
-                glDrawArrays(GL_TRIANGLES, 0, GLsizei(mesh.vertices.size()));
+                glDrawArrays(GL_TRIANGLES, 0, drawFirstVertex(int64_t(mesh.triangles.size())));
             }
             glDisable(GL_DEPTH_TEST);
             // accumulate this sample's share into the direct map, page by page
@@ -159,9 +160,8 @@ void Baker::Impl::bakeEmitters() {
             glViewport(0, 0, layout.resolution, layout.resolution);
             for (int page = 0; page < layout.pageCount; ++page) {
                 glUniform1i(emitterProgram.uniform("page"), page);
-                GLint first = GLint(mesh.pageFirstTriangle[page] * 3);
-                GLsizei count = GLsizei((mesh.pageFirstTriangle[page + 1] - mesh.pageFirstTriangle[page]) * 3);
-                if (count) glDrawArrays(GL_TRIANGLES, first, count);
+                const int64_t count = int64_t(mesh.pageFirstTriangle[page + 1]) - mesh.pageFirstTriangle[page];
+                if (count) glDrawArrays(GL_TRIANGLES, drawFirstVertex(mesh.pageFirstTriangle[page]), GLsizei(count * 3));
             }
             glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
             ++stats.emitterSampleCount;

@@ -70,9 +70,6 @@ Expected<ImportanceGlResult> ImportanceAnalyzer::analyze(const BakeMesh& mesh, i
         return Status::error("light map resolution " + std::to_string(resolution) +
                              " exceeds this GL's texture/viewport/framebuffer limit " + std::to_string(maxSide));
     if (Status drawable = checkMeshDrawable(int64_t(n)); !drawable) return drawable;
-    if (capture.positionBuffers && int64_t(resolution) * resolution * 16 > int64_t(INT32_MAX))
-        return Status::error("capturing the position buffer of a " + std::to_string(resolution) +
-                             "^2 page exceeds one 2 GiB read-back");
     if (n == 0) return result;
 
     gl::DebugGroup group("importance analysis");
@@ -157,10 +154,10 @@ Expected<ImportanceGlResult> ImportanceAnalyzer::analyze(const BakeMesh& mesh, i
         auto tr = Clock::now();
         if (capture.texelTriangles || capture.positionBuffers) {
             std::vector<uint32_t> ids(texels);
-            glGetTextureImage(triangles.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, GLsizei(texels * 4), ids.data());
+            gl::readTexture(triangles.id(), 0, 0, 0, resolution, resolution, 1, GL_RED_INTEGER, GL_UNSIGNED_INT, 4, ids.data());
             if (capture.positionBuffers) {
                 std::vector<glm::vec4> p(texels);
-                glGetTextureImage(positions.id(), 0, GL_RGBA, GL_FLOAT, GLsizei(texels * 16), p.data());
+                gl::readTexture(positions.id(), 0, 0, 0, resolution, resolution, 1, GL_RGBA, GL_FLOAT, 16, p.data());
                 PositionBuffer buffer;
                 buffer.resolution = resolution;
                 buffer.texels.resize(texels);
@@ -171,7 +168,7 @@ Expected<ImportanceGlResult> ImportanceAnalyzer::analyze(const BakeMesh& mesh, i
         }
         if (capture.texelDensity) {
             std::vector<float> d(texels);
-            glGetTextureImage(density.id(), 0, GL_RED, GL_FLOAT, GLsizei(texels * 4), d.data());
+            gl::readTexture(density.id(), 0, 0, 0, resolution, resolution, 1, GL_RED, GL_FLOAT, 4, d.data());
             result.texelDensity.push_back(std::move(d));
         }
         result.seconds.readback += secondsSince(tr);

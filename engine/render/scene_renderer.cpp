@@ -377,7 +377,7 @@ LightmapPages SceneRenderer::readLightmaps() const {
     glGetTextureLevelParameteriv(m.lightmapTexture, 0, GL_TEXTURE_DEPTH, &layers);
     if (w <= 0 || h <= 0 || layers <= 0) return out;
     std::vector<glm::vec4> texels(size_t(w) * h * layers);
-    glGetTextureImage(m.lightmapTexture, 0, GL_RGBA, GL_FLOAT, GLsizei(texels.size() * sizeof(glm::vec4)), texels.data());
+    gl::readTexture(m.lightmapTexture, 0, 0, 0, w, h, layers, GL_RGBA, GL_FLOAT, 16, texels.data());
     out.resolution = w;
     for (int p = 0; p < layers; ++p) {
         io::ImageRgb page;
