@@ -21,7 +21,8 @@
 // - Directional lights take the node's world linear transform applied to
 //   (0,0,-1), normalized (the rotation when the scale is uniform).
 // - Images are kept encoded while tinygltf parses and decoded only when a used
-//   material needs them; one that fails to decode is a warning, not an error.
+//   material needs them; one that cannot be read or decoded is an error (a bake
+//   without it would be silently wrong), an unused one is never looked at.
 // - Degenerate triangles: a repeated index, or |cross| <= 1e-12 * (diagonal of
 //   the primitive's bounding box)^2, computed in double from the float positions.
 // Not converted: alphaMode (cut-outs bake opaque), skins and morph targets (the
@@ -30,6 +31,8 @@
 #include "scene/scene.h"
 
 #include <tiny_gltf.h>
+
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cerrno>
@@ -103,6 +106,57 @@ bool keepEncodedImage(tinygltf::Image* image, const int, std::string*, std::stri
     return true;
 }
 
+// "MAJOR.MINOR" (glTF's asset.version pattern) as two numbers, or nothing.
+std::optional<std::pair<long, long>> parseVersion(const std::string& text) {
+    const size_t dot = text.find('.');
+    if (dot == std::string::npos || dot == 0 || dot + 1 == text.size() || dot > 9 || text.size() - dot > 10) return {};
+    for (size_t i = 0; i < text.size(); ++i)
+        if (i != dot && (text[i] < '0' || text[i] > '9')) return {};
+    return std::make_pair(std::stol(text.substr(0, dot)), std::stol(text.substr(dot + 1)));
+}
+
+// The "asset" object of a .gltf text or of a .glb's JSON chunk, parsed without
+// tinygltf (null when there is none or the JSON does not parse).
+nlohmann::json assetOf(const std::vector<unsigned char>& bytes, bool binary) {
+    const unsigned char* json = bytes.data();
+    size_t length = bytes.size();
+    if (binary) {
+        if (bytes.size() < 20) return nullptr;
+        uint32_t chunkLength = 0;
+        std::memcpy(&chunkLength, bytes.data() + 12, 4);
+        if (chunkLength > bytes.size() - 20) return nullptr;
+        json = bytes.data() + 20;
+        length = chunkLength;
+    }
+    nlohmann::json doc = nlohmann::json::parse(json, json + length, nullptr, false);
+    if (doc.is_discarded() || !doc.is_object() || !doc.contains("asset")) return nullptr;
+    return doc["asset"];
+}
+
+// glTF 2.0 only: asset.version's major must be 2 and a minVersion, when
+// present, at most 2.0 (glTF 2.0 spec, 3.2 "Asset"). Null passes (tinygltf
+// reports a missing asset itself).
+Status checkAssetVersion(const nlohmann::json& asset) {
+    if (!asset.is_object()) return Status::ok();
+    const auto text = [](const nlohmann::json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); };
+    if (asset.contains("version")) {
+        const std::string version = text(asset["version"]);
+        const auto v = parseVersion(version);
+        if (!v) return Status::error("asset.version '" + version + "' is not MAJOR.MINOR: not a glTF 2.0 file");
+        if (v->first != 2)
+            return Status::error("glTF " + version + " is not supported: bundlebake reads glTF 2.0 only (asset.version must be 2.x)");
+    }
+    if (asset.contains("minVersion")) {
+        const std::string minVersion = text(asset["minVersion"]);
+        const auto v = parseVersion(minVersion);
+        if (!v) return Status::error("asset.minVersion '" + minVersion + "' is not MAJOR.MINOR");
+        if (v->first != 2 || v->second > 0)
+            return Status::error("the file requires glTF " + minVersion +
+                                 " (asset.minVersion): bundlebake reads glTF 2.0 only");
+    }
+    return Status::ok();
+}
+
 float srgbToLinear(float c) {
     return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
 }
@@ -140,6 +194,9 @@ std::optional<double> numberMember(const tinygltf::Value& v, const char* key) {
 
 class SceneBuilder {
 public:
+    // Warnings met while building, for the caller to log once the load has
+    // succeeded: a refused file gives one error line and nothing else.
+    const std::vector<std::string>& warnings() const { return warnings_; }
     SceneBuilder(const tinygltf::Model& model, const LoadOptions& options, Scene& scene)
         : model_(model), options_(options), scene_(scene) {}
 
@@ -174,6 +231,9 @@ private:
     std::vector<UvSource> materialUv_;  // per scene material
     int defaultMaterial_ = -1;
     std::map<std::pair<int, bool>, std::optional<Texture>> decoded_;  // (image, sRGB) -> texels
+    std::string imageError_;  // set by decodedImage when a used image cannot be read or decoded
+    std::vector<std::string> warnings_;  // logged by loadScene only when the load succeeds
+    void deferWarning(std::string message) { warnings_.push_back(std::move(message)); }
     std::map<std::string, int> textureKeys_;                          // dedup of Scene::textures
     size_t skippedLights_ = 0;
     size_t badNormals_ = 0;
@@ -388,13 +448,13 @@ TextureRef SceneBuilder::textureRef(const tinygltf::TextureInfo& info, const std
     TextureRef ref;
     if (info.index < 0) return ref;
     if (size_t(info.index) >= model_.textures.size()) {
-        logWarning(scene_.path + ": " + materialLabel + ": " + slot + " refers to missing texture " +
+        deferWarning(scene_.path + ": " + materialLabel + ": " + slot + " refers to missing texture " +
                    std::to_string(info.index) + "; ignored");
         return ref;
     }
     const tinygltf::Texture& texture = model_.textures[size_t(info.index)];
     if (texture.source < 0 || size_t(texture.source) >= model_.images.size()) {
-        logWarning(scene_.path + ": " + materialLabel + ": " + slot + " (texture " + std::to_string(info.index) +
+        deferWarning(scene_.path + ": " + materialLabel + ": " + slot + " (texture " + std::to_string(info.index) +
                    ") has no image bundlebake can decode (only PNG, JPEG and the like); ignored");
         return ref;
     }
@@ -416,13 +476,13 @@ const Texture* SceneBuilder::decodedImage(int imageIndex, bool srgb, const std::
     tinygltf::Image pixels;  // stb through tinygltf: 8 or 16 bits, always expanded to RGBA
     std::string err, warn;
     if (image.image.empty()) {
-        logWarning(scene_.path + ": " + usage + ": " + label + " could not be read; texture ignored");
+        imageError_ = usage + ": " + label + " could not be read (missing or empty file, or a bad URI)";
     } else if (image.image.size() > size_t(std::numeric_limits<int>::max()) ||
                !tinygltf::LoadImageData(&pixels, imageIndex, &err, &warn, 0, 0, image.image.data(),
                                         int(image.image.size()), nullptr) ||
                pixels.component != 4 || (pixels.bits != 8 && pixels.bits != 16)) {
-        logWarning(scene_.path + ": " + usage + ": " + label + " could not be decoded (" +
-                   oneLine(err.empty() ? "unsupported format" : err, 160) + "); texture ignored");
+        imageError_ = usage + ": " + label + " could not be decoded (" +
+                      oneLine(err.empty() ? "unsupported format" : err, 160) + ")";
     } else {
         Texture t;
         t.name = image.name.empty() ? (image.uri.empty() ? "image " + std::to_string(imageIndex) : image.uri)
@@ -513,6 +573,7 @@ Status SceneBuilder::sceneMaterial(int gltfMaterial, int* out) {
     const Texture* baseTexels = base.image >= 0 ? decodedImage(base.image, true, label + " baseColorTexture") : nullptr;
     const Texture* mrTexels =
         mr.image >= 0 ? decodedImage(mr.image, false, label + " metallicRoughnessTexture") : nullptr;
+    if (!imageError_.empty()) return Status::error(imageError_);
     m.albedo = baseColor * (1.0f - metallic);
     if (mrTexels && (!baseTexels || base.uv == mr.uv)) {
         // (1 - metallic * B) multiplied into a derived albedo texture
@@ -551,7 +612,7 @@ Status SceneBuilder::sceneMaterial(int gltfMaterial, int* out) {
             for (const glm::vec4& t : mrTexels->texels) sum += t.b;
             float meanB = mrTexels->texels.empty() ? 0.0f : float(sum / double(mrTexels->texels.size()));
             m.albedo = baseColor * (1.0f - metallic * meanB);
-            logWarning(scene_.path + ": " + label +
+            deferWarning(scene_.path + ": " + label +
                        ": metallicRoughnessTexture and baseColorTexture use different texture coordinates; "
                        "albedo uses the texture's mean metallic");
         }
@@ -570,13 +631,15 @@ Status SceneBuilder::sceneMaterial(int gltfMaterial, int* out) {
     if (glm::any(glm::greaterThan(m.emission, glm::vec3(0.0f)))) {
         TextureRef emissive = textureRef(src.emissiveTexture, label, "emissiveTexture");
         if (emissive.image >= 0) {
-            if (const Texture* t = decodedImage(emissive.image, true, label + " emissiveTexture")) {
+            const Texture* t = decodedImage(emissive.image, true, label + " emissiveTexture");
+            if (!imageError_.empty()) return Status::error(imageError_);
+            if (t) {
                 m.emissionTexture = addTexture("srgb:" + std::to_string(emissive.image), *t);
                 if (!haveUv) {
                     uv = emissive.uv;
                     haveUv = true;
                 } else if (!(uv == emissive.uv)) {
-                    logWarning(scene_.path + ": " + label +
+                    deferWarning(scene_.path + ": " + label +
                                ": emissiveTexture uses other texture coordinates than the albedo texture; "
                                "it is sampled with the albedo texture's");
                 }
@@ -902,7 +965,7 @@ Status SceneBuilder::visitNode(int nodeIndex, const glm::dmat4& worldFromNode, f
                 light.direction = glm::vec3(d / len);
                 scene_.lights.push_back(std::move(light));
             } else {
-                logWarning(scene_.path + ": " + label + ": directional light with a degenerate transform or "
+                deferWarning(scene_.path + ": " + label + ": directional light with a degenerate transform or "
                                                         "intensity skipped");
             }
         } else {
@@ -916,7 +979,10 @@ Status SceneBuilder::traverse() {
     const size_t nodeCount = model_.nodes.size();
     // roots: the default scene, else every scene, else every node without a parent
     std::vector<int> roots;
-    if (model_.defaultScene >= 0 && size_t(model_.defaultScene) < model_.scenes.size()) {
+    if (model_.defaultScene >= 0 && size_t(model_.defaultScene) >= model_.scenes.size())
+        return Status::error("the default scene " + std::to_string(model_.defaultScene) + " does not exist (the file has " +
+                             std::to_string(model_.scenes.size()) + " scene(s))");
+    if (model_.defaultScene >= 0) {
         roots = model_.scenes[size_t(model_.defaultScene)].nodes;
     } else if (!model_.scenes.empty()) {
         for (const tinygltf::Scene& s : model_.scenes) roots.insert(roots.end(), s.nodes.begin(), s.nodes.end());
@@ -959,7 +1025,7 @@ Status SceneBuilder::traverse() {
             if (std::isfinite(*d) && *d > 0.0) {
                 density = float(*d);
             } else {
-                logWarning(scene_.path + ": " + quoted(node.name, "node", item.node) +
+                deferWarning(scene_.path + ": " + quoted(node.name, "node", item.node) +
                            ": extras.texelDensity must be a positive number; ignored");
             }
         }
@@ -986,25 +1052,25 @@ Status SceneBuilder::build() {
     // one warning per kind of thing skipped or substituted
     const LoadReport& r = scene_.report;
     if (r.skippedNonTrianglePrimitives > 0)
-        logWarning(scene_.path + ": skipped " + std::to_string(r.skippedNonTrianglePrimitives) +
+        deferWarning(scene_.path + ": skipped " + std::to_string(r.skippedNonTrianglePrimitives) +
                    " point/line primitive(s): only triangles are baked");
     if (r.skippedDegenerateTriangles > 0)
-        logWarning(scene_.path + ": skipped " + std::to_string(r.skippedDegenerateTriangles) +
+        deferWarning(scene_.path + ": skipped " + std::to_string(r.skippedDegenerateTriangles) +
                    " degenerate triangle(s) (repeated index or zero area)");
     if (r.primitivesWithoutMaterial > 0) {
         const glm::vec3 a = options_.defaultAlbedo;
         char albedo[64];
         std::snprintf(albedo, sizeof albedo, "(%g, %g, %g)", double(a.x), double(a.y), double(a.z));
-        logWarning(scene_.path + ": " + std::to_string(r.primitivesWithoutMaterial) +
+        deferWarning(scene_.path + ": " + std::to_string(r.primitivesWithoutMaterial) +
                    " primitive(s) have no material: using bundlebake's default diffuse albedo " + albedo +
                    " instead of glTF's default material, which is fully metallic and would bake black");
     }
     if (skippedLights_ > 0)
-        logWarning(scene_.path + ": skipped " + std::to_string(skippedLights_) +
+        deferWarning(scene_.path + ": skipped " + std::to_string(skippedLights_) +
                    " point/spot light(s): only KHR_lights_punctual directional lights are baked "
                    "(use emissive geometry instead)");
     if (badNormals_ > 0)
-        logWarning(scene_.path + ": " + std::to_string(badNormals_) +
+        deferWarning(scene_.path + ": " + std::to_string(badNormals_) +
                    " zero or non-finite normal(s) replaced by face normals");
 
     // world bounds over every instanced vertex, in double; the local origin from them
@@ -1045,17 +1111,27 @@ Expected<Scene> loadScene(const std::string& path, const LoadOptions& options) {
     if (!in) return fail(std::string("cannot open file (") + std::strerror(errno) + ")");
     std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     if (in.bad()) return fail("cannot read file");
+    return loadSceneFromMemory(std::move(bytes), path, std::filesystem::path(path).parent_path().string(), options);
+}
+
+Expected<Scene> loadSceneFromMemory(std::vector<unsigned char> bytes, const std::string& path, const std::string& baseDir,
+                                    const LoadOptions& options) {
+    auto fail = [&](const std::string& what) { return Expected<Scene>::failure(oneLine(path + ": " + what, 600)); };
     if (bytes.size() > std::numeric_limits<unsigned int>::max()) return fail("file is larger than 4 GiB");
 
     const std::filesystem::path fsPath(path);
     std::string extension = fsPath.extension().string();
     std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return char(std::tolower(c)); });
     const bool binary = extension == ".glb" || (bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0);
-    const std::string baseDir = fsPath.parent_path().string();
 
     if (binary && bytes.size() >= 12 && std::memcmp(bytes.data(), "glTF", 4) == 0) {
-        uint32_t declared = 0;
-        std::memcpy(&declared, bytes.data() + 8, 4);  // little-endian, as the host
+        uint32_t container = 0, declared = 0;
+        std::memcpy(&container, bytes.data() + 4, 4);  // little-endian, as the host
+        std::memcpy(&declared, bytes.data() + 8, 4);
+        if (container != 2)
+            return fail("glTF binary container version " + std::to_string(container) + " (" +
+                        (container == 1 ? std::string("glTF 1.0, KHR_binary_glTF") : std::string("unknown")) +
+                        ") is not supported: bundlebake reads glTF 2.0 only");
         if (declared > bytes.size())
             return fail("not a valid glTF binary (.glb): truncated, the header says " + std::to_string(declared) +
                         " bytes but the file has " + std::to_string(bytes.size()));
@@ -1063,6 +1139,17 @@ Expected<Scene> loadScene(const std::string& path, const LoadOptions& options) {
 
     tinygltf::TinyGLTF gltf;
     gltf.SetImageLoader(&keepEncodedImage, nullptr);
+    if (!options.externalFiles) {
+        tinygltf::FsCallbacks noFiles = {};
+        noFiles.FileExists = [](const std::string&, void*) { return false; };
+        noFiles.ExpandFilePath = [](const std::string& path, void*) { return path; };
+        noFiles.ReadWholeFile = [](std::vector<unsigned char>*, std::string* err, const std::string& path, void*) {
+            if (err) *err += "external file '" + path + "' not read (external files are off)\n";
+            return false;
+        };
+        noFiles.WriteWholeFile = [](std::string*, const std::string&, const std::vector<unsigned char>&, void*) { return false; };
+        gltf.SetFsCallbacks(noFiles);
+    }
     tinygltf::Model model;
     std::string err, warn;
     bool ok = false;
@@ -1077,12 +1164,19 @@ Expected<Scene> loadScene(const std::string& path, const LoadOptions& options) {
         ok = false;
         err = e.what();
     }
-    if (!ok)
+    if (!ok) {
+        // a glTF 1.0 file usually fails tinygltf's 2.0 schema first: say why instead
+        if (Status v = checkAssetVersion(assetOf(bytes, binary)); !v) return fail(v.message());
         return fail(std::string(binary ? "not a valid glTF binary (.glb): " : "not a valid glTF file: ") +
                     (err.empty() ? "unknown error" : err));
+    }
+    {
+        nlohmann::json asset = {{"version", model.asset.version}};
+        if (!model.asset.minVersion.empty()) asset["minVersion"] = model.asset.minVersion;
+        if (Status v = checkAssetVersion(asset); !v) return fail(v.message());
+    }
     bytes.clear();
     bytes.shrink_to_fit();
-    if (!warn.empty()) logWarning(oneLine(path + ": tinygltf: " + warn));
 
     Scene scene;
     scene.path = path;
@@ -1094,6 +1188,9 @@ Expected<Scene> loadScene(const std::string& path, const LoadOptions& options) {
         built = Status::error("out of memory while converting the scene");
     }
     if (!built) return fail(built.message());
+    // warnings only for a file that loads: a refused one gives its one error line alone
+    if (!warn.empty()) logWarning(oneLine(path + ": tinygltf: " + warn));
+    for (const std::string& w : builder.warnings()) logWarning(w);
     return Expected<Scene>(std::move(scene));
 }
 

@@ -153,13 +153,24 @@ glm::dvec3 chooseLocalOrigin(const glm::dvec3& lo, const glm::dvec3& hi);
 struct LoadOptions {
     glm::vec3 defaultAlbedo{0.8f};  // for primitives without a material (glTF's default is metallic, i.e. black)
     bool requireUv1 = false;        // fail with a hint if any primitive lacks TEXCOORD_1
+    bool externalFiles = true;      // false: buffer and image URIs other than data: are not read (fuzzing)
 };
 
 // Loads a .gltf or .glb file. Errors (one line each, naming the file and what
-// is wrong): missing/unreadable file, parse error, NaN/Inf positions (names the
-// mesh), missing TEXCOORD_1 when requireUv1 is set, nothing to bake (no triangles).
+// is wrong): missing/unreadable file, parse error, a glTF version other than
+// 2.x, NaN/Inf positions (names the mesh), a texture of a used material that
+// cannot be read or decoded, missing TEXCOORD_1 when requireUv1 is set,
+// nothing to bake (no triangles).
 // Non-triangle primitives and degenerate triangles are skipped and counted in
 // Scene::report; a warning is logged for each kind.
 Expected<Scene> loadScene(const std::string& path, const LoadOptions& options = {});
+
+// The same from a file's bytes (fuzzing, tests): `path` names the file in
+// errors and chooses .glb by its extension (else the "glTF" magic decides);
+// external URIs resolve against `baseDir`. Files other than glTF 2.0 (asset
+// version major 2, minVersion at most 2.0, .glb container version 2) are
+// refused in one line.
+Expected<Scene> loadSceneFromMemory(std::vector<unsigned char> bytes, const std::string& path, const std::string& baseDir,
+                                    const LoadOptions& options = {});
 
 }  // namespace bb
