@@ -1,5 +1,7 @@
 #include "headless/platform.h"
 
+#include <cstdlib>
+
 namespace bb {
 
 Expected<Backend> parseBackend(const std::string& name) {
@@ -11,6 +13,10 @@ Expected<Backend> parseBackend(const std::string& name) {
 const char* backendName(Backend backend) { return backend == Backend::Egl ? "egl" : "osmesa"; }
 
 Expected<std::unique_ptr<gl::Context>> createHeadlessContext(Backend backend) {
+    // a machine without GL, on demand: the suite must fail there (tests/CMakeLists.txt, gl_fails_without_context)
+    if (const char* force = std::getenv("BUNDLEBAKE_FORCE_NO_GL"); force && *force && std::string(force) != "0")
+        return Expected<std::unique_ptr<gl::Context>>::failure(std::string(backendName(backend)) +
+                                                                ": context creation disabled by BUNDLEBAKE_FORCE_NO_GL");
     if (backend == Backend::Egl) return createEglContext();
 #ifdef BUNDLEBAKE_WITH_OSMESA
     return createOsMesaContext();

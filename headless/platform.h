@@ -17,7 +17,9 @@ Expected<Backend> parseBackend(const std::string& name);
 const char* backendName(Backend backend);
 
 // Creates a 4.3 core context and makes it current. The error names the
-// backend and what was found instead.
+// backend and what was found instead. With the environment variable
+// BUNDLEBAKE_FORCE_NO_GL set (not empty, not "0") it always fails, as on a
+// machine without GL (tests use it to show that the suite then fails).
 Expected<std::unique_ptr<gl::Context>> createHeadlessContext(Backend backend);
 
 // Implementations (platform_egl.cpp, platform_osmesa.cpp).

@@ -49,7 +49,7 @@ bool backendAvailable(Backend backend, std::string* why) {
 
 TEST(CliDeterminism, SameSeedSameBytesOtherSeedOtherBytes) {
     std::string why;
-    if (!backendAvailable(defaultTestBackend(), &why)) GTEST_SKIP() << why;
+    ASSERT_TRUE(backendAvailable(defaultTestBackend(), &why)) << why;
     const std::string backend = backendName(defaultTestBackend());
     TempDir tmp("determinism");
     ASSERT_TRUE(tmp.ok());
@@ -80,8 +80,11 @@ TEST(CliDeterminism, SameSeedSameBytesOtherSeedOtherBytes) {
 // are hash-based and do not depend on scheduling.
 TEST(CliDeterminism, EglAndOsMesaGiveSameBytes) {
     std::string why;
-    if (!backendAvailable(Backend::Egl, &why)) GTEST_SKIP() << "EGL: " << why;
-    if (!backendAvailable(Backend::OsMesa, &why)) GTEST_SKIP() << "OSMesa: " << why;
+    ASSERT_TRUE(backendAvailable(Backend::Egl, &why)) << "EGL: " << why;
+#ifndef BUNDLEBAKE_WITH_OSMESA
+    GTEST_SKIP() << "this build has no OSMesa backend (configured with -DBUNDLEBAKE_WITH_OSMESA=OFF)";
+#endif
+    ASSERT_TRUE(backendAvailable(Backend::OsMesa, &why)) << "OSMesa: " << why;
     TempDir tmp("backends");
     ASSERT_TRUE(tmp.ok());
     CliResult egl = runCli(bakeArgs(tmp / "egl", "egl", 5), tmp);

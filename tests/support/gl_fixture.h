@@ -24,9 +24,10 @@ std::string sourcePath(const std::string& relative);
 
 }  // namespace bb::test
 
-// Skips (with the reason) only when no GL context can be made at all.
-#define BB_REQUIRE_GL()                                                   \
-    do {                                                                  \
-        std::string whyNoGl_;                                             \
-        if (!::bb::test::sharedContext(&whyNoGl_)) GTEST_SKIP() << whyNoGl_; \
+// Fails the test (never skips: a green run must mean GL ran) when no GL
+// context can be made; BUNDLEBAKE_FORCE_NO_GL=1 shows it (gl_fails_without_context).
+#define BB_REQUIRE_GL()                                                  \
+    do {                                                                 \
+        std::string whyNoGl_;                                            \
+        if (!::bb::test::sharedContext(&whyNoGl_)) FAIL() << whyNoGl_;   \
     } while (0)
