@@ -79,14 +79,35 @@ Status Baker::loadCheckpoint(const std::string& path) {
     if (!f) return Status::error("cannot read checkpoint " + path);
     CheckpointHeader h{};
     const int res = m.layout.resolution;
-    std::vector<glm::uvec2> raw(size_t(res) * res * m.layout.pageCount);
-    std::vector<uint32_t> radiance(raw.size());
-    bool ok = std::fread(&h, sizeof h, 1, f) == 1 && std::memcmp(h.magic, CHECKPOINT_MAGIC, 8) == 0 &&
-              h.resolution == res && h.pages == m.layout.pageCount &&
-              std::fread(raw.data(), sizeof(glm::uvec2), raw.size(), f) == raw.size() &&
-              std::fread(radiance.data(), sizeof(uint32_t), radiance.size(), f) == radiance.size();
+    const size_t texels = size_t(res) * res * m.layout.pageCount;
+    const size_t expectedBytes = sizeof h + texels * (sizeof(glm::uvec2) + sizeof(uint32_t));
+    // every way a file can fail to be this layout's checkpoint, said before anything is read into GL
+    const bool headerRead = std::fread(&h, sizeof h, 1, f) == 1;
+    size_t fileBytes = 0;
+    if (std::fseek(f, 0, SEEK_END) == 0) {
+        const long end = std::ftell(f);
+        fileBytes = end > 0 ? size_t(end) : 0;
+    }
+    auto refuse = [&](const std::string& why) {
+        std::fclose(f);
+        return Status::error(path + " is not a bundlebake checkpoint of this layout: " + why +
+                             " (remove it or bake without --resume)");
+    };
+    if (!headerRead) return refuse("shorter than its " + std::to_string(sizeof h) + "-byte header");
+    if (std::memcmp(h.magic, CHECKPOINT_MAGIC, 8) != 0) return refuse("wrong magic or format version");
+    if (h.resolution != res || h.pages != m.layout.pageCount)
+        return refuse("it holds " + std::to_string(h.pages) + " page(s) of " + std::to_string(h.resolution) + "^2, this bake " +
+                      std::to_string(m.layout.pageCount) + " of " + std::to_string(res) + "^2");
+    if (fileBytes != expectedBytes)
+        return refuse(std::to_string(fileBytes) + " bytes where this layout's checkpoint has " + std::to_string(expectedBytes));
+    if (!(std::isfinite(h.accumScale) && h.accumScale > 0.0)) return refuse("corrupt accumulator scale");
+    std::vector<glm::uvec2> raw(texels);
+    std::vector<uint32_t> radiance(texels);
+    const bool ok = std::fseek(f, long(sizeof h), SEEK_SET) == 0 &&
+                    std::fread(raw.data(), sizeof(glm::uvec2), raw.size(), f) == raw.size() &&
+                    std::fread(radiance.data(), sizeof(uint32_t), radiance.size(), f) == radiance.size();
     std::fclose(f);
-    if (!ok) return Status::error(path + " is not a bundlebake checkpoint of this layout");
+    if (!ok) return Status::error("cannot read checkpoint " + path);
     if (h.key != checkpointKey(m.mesh, m.layout, m.options, m.historyPower))
         return Status::error(path + " was written for another scene or other bake options; remove it or bake without --resume");
     if (h.directionsDone < 0 || h.directionsDone > m.options.directions)

@@ -161,6 +161,10 @@ Expected<ImageRgb> readImageRgb(const std::string& path) {
     const int width = spec.width, height = spec.height, channels = spec.nchannels;
     if (width <= 0 || height <= 0 || channels <= 0) return fail("empty image");
     if (spec.deep) return fail("deep images are not supported");
+    // bounds before allocation: a header may claim any size
+    if (int64_t(width) * height > MAX_IMAGE_PIXELS || int64_t(width) * height * channels > 4 * MAX_IMAGE_PIXELS)
+        return fail(std::to_string(width) + " x " + std::to_string(height) + " x " + std::to_string(channels) +
+                    " channels is larger than bundlebake reads (" + std::to_string(MAX_IMAGE_PIXELS >> 20) + " M pixels)");
 
     std::vector<float> data(size_t(width) * size_t(height) * size_t(channels));
     if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, data.data())) return fail(oneLine(in->geterror()));

@@ -3,6 +3,7 @@
 // holds a partial or corrupt file.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -31,8 +32,13 @@ void flipRows(ImageRgb& image);
 Status writeExrHalf(const std::string& path, const ImageRgb& image,
                     const std::vector<std::pair<std::string, std::string>>& attributes = {});
 
+// Largest image readImageRgb accepts (width x height): 256 M pixels, e.g. a
+// 16384 x 8192 environment map is 128 M. Checked before any allocation.
+constexpr int64_t MAX_IMAGE_PIXELS = int64_t(1) << 28;
+
 // Reads any OIIO-readable image (EXR, HDR, PNG...) as linear RGB float
-// (8-bit formats are taken as sRGB and linearized). Error names the file.
+// (8-bit formats are taken as sRGB and linearized). Error names the file;
+// images larger than MAX_IMAGE_PIXELS are refused before allocation.
 Expected<ImageRgb> readImageRgb(const std::string& path);
 
 // 8-bit sRGB PNG of a linear image: scaled by 2^exposure, then ACES-fitted
