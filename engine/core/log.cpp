@@ -2,17 +2,46 @@
 
 #include <atomic>
 #include <cstdio>
+#include <mutex>
+#include <vector>
 
 namespace bb {
 namespace {
 std::atomic<int> gLevel{static_cast<int>(LogLevel::Info)};
 std::atomic<int> gWarnings{0};
+std::mutex gHeldMutex;
+bool gHolding = false;
+std::vector<std::string> gHeld;  // formatted lines, in order
 
 void emit(LogLevel level, const char* tag, const std::string& message) {
     if (static_cast<int>(level) < gLevel.load()) return;
-    std::fprintf(stderr, "bundlebake: %s%s\n", tag, message.c_str());
+    const std::string line = std::string("bundlebake: ") + tag + message + "\n";
+    if (level == LogLevel::Info || level == LogLevel::Warning) {
+        std::lock_guard<std::mutex> lock(gHeldMutex);
+        if (gHolding) {
+            gHeld.push_back(line);
+            return;
+        }
+    }
+    std::fputs(line.c_str(), stderr);
 }
 }  // namespace
+
+void holdLogMessages() {
+    std::lock_guard<std::mutex> lock(gHeldMutex);
+    gHolding = true;
+}
+void releaseHeldLogMessages() {
+    std::lock_guard<std::mutex> lock(gHeldMutex);
+    for (const std::string& line : gHeld) std::fputs(line.c_str(), stderr);
+    gHeld.clear();
+    gHolding = false;
+}
+void discardHeldLogMessages() {
+    std::lock_guard<std::mutex> lock(gHeldMutex);
+    gHeld.clear();
+    gHolding = false;
+}
 
 void setLogLevel(LogLevel level) { gLevel = static_cast<int>(level); }
 LogLevel logLevel() { return static_cast<LogLevel>(gLevel.load()); }

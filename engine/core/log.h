@@ -18,4 +18,23 @@ void logError(const std::string& message);
 
 int warningCount();
 
+// Holding: while held, info and warning lines are kept instead of printed
+// (errors and debug lines print at once). A program that refuses its input
+// in one line holds until the input is accepted, then releases (prints the
+// kept lines in order) or, on error, discards them: bad input gives its one
+// error line alone. warningCount() counts held warnings too.
+void holdLogMessages();
+void releaseHeldLogMessages();
+void discardHeldLogMessages();
+
+// Holds for its scope; discards on destruction unless released.
+class LogHold {
+public:
+    LogHold() { holdLogMessages(); }
+    ~LogHold() { discardHeldLogMessages(); }
+    LogHold(const LogHold&) = delete;
+    LogHold& operator=(const LogHold&) = delete;
+    void release() { releaseHeldLogMessages(); }
+};
+
 }  // namespace bb

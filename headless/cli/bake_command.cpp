@@ -73,6 +73,9 @@ void addBakeCommand(CLI::App& app, std::function<int()>& action) {
 }
 
 int runBake(const BakeArgs& args) {
+    // until the bake starts, a refused input gives its one error line alone:
+    // warnings about a scene that is then refused are dropped with it
+    LogHold hold;
     auto backend = parseBackend(args.backend);
     if (!backend) return fail(backend.error());
     auto budget = parseSize(args.memoryBudget, "--memory-budget");
@@ -108,6 +111,7 @@ int runBake(const BakeArgs& args) {
         if (Status s = (*baker)->loadCheckpoint(checkpoint); !s) return fail(s.message());
         logInfo("resuming from " + checkpoint + " at direction " + std::to_string((*baker)->progress().directionsDone));
     }
+    hold.release();  // the input is accepted: print what was said about it
     ProgressBar bar(args.progress, isatty(STDERR_FILENO));
     auto t0 = std::chrono::steady_clock::now();
     int lastCheckpoint = (*baker)->progress().directionsDone;

@@ -153,6 +153,9 @@ def main():
         d["accessors"][0]["sparse"] = {"count": 1, "indices": {"bufferView": n - 2, "componentType": 5125},
                                        "values": {"bufferView": n - 1}}
     write("gltf/sparse_index_out_of_range.gltf", triangle(extra=sparse))
+    # loads with a warning (no material), then the layout refuses it (no TEXCOORD_1): the error line alone
+    write("gltf/no_uv1_warning_first.gltf", triangle(extra=lambda d: (
+        d["meshes"][0]["primitives"][0].pop("material"), d["meshes"][0]["primitives"][0]["attributes"].pop("TEXCOORD_1"))))
     write("gltf/uv1_accessor_too_short.gltf", triangle(extra=lambda d: d["accessors"][1].update(count=2)))
     # --- glb ----------------------------------------------------------------
     good_glb = glb(d, raw)
@@ -189,8 +192,13 @@ def main():
     tmp = tempfile.mkdtemp()
     try:
         exr = os.path.join(tmp, "env.exr")
-        subprocess.run(["oiiotool", "--pattern", "constant:color=1,1,1", "16x8", "3", "-d", "half", "-o", exr], check=True)
+        subprocess.run(["oiiotool", "--nosoftwareattrib", "--pattern", "constant:color=1,1,1", "16x8", "3", "-d", "half", "-o", exr], check=True)
         exr_bytes = open(exr, "rb").read()
+        # OpenEXR stamps capDate "YYYY:MM:DD hh:mm:ss": fix it, so the corpus is the same bytes each run
+        at = exr_bytes.find(b"capDate\0string\0")
+        if at >= 0:
+            value = at + len(b"capDate\0string\0") + 4
+            exr_bytes = exr_bytes[:value] + b"2000:01:01 00:00:00" + exr_bytes[value + 19:]
     finally:
         shutil.rmtree(tmp)
     write("env/empty.exr", b"")
