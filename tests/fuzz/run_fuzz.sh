@@ -4,6 +4,7 @@
 # scratch directory, never into the source tree; a crash, sanitizer report or
 # leak fails the run and leaves the input as crash-* in the scratch directory
 # (kept, and printed, on failure).
+# With the dictionary tests/fuzz/gltf.dict (glTF keys, .glb tags).
 # Usage: run_fuzz.sh FUZZER SOURCE_DIR [libFuzzer options...]
 #   ctest (gltf_fuzz_short): -runs=40000 -seed=1
 #   longer by hand:          run_fuzz.sh <build>/fuzz/gltf_fuzzer . -max_total_time=1200
@@ -18,7 +19,7 @@ scratch=$(mktemp -d "${TMPDIR:-/tmp}/bundlebake-fuzz-XXXXXX") || exit 1
 mkdir -p "$scratch/corpus"
 cd "$scratch" || exit 1
 # -timeout: one input may take at most 10 s; -rss_limit_mb: 2 GB; inputs up to 64 KiB
-"$fuzzer" -max_len=65536 -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 "$@" \
+"$fuzzer" -max_len=65536 -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 -dict="$source/tests/fuzz/gltf.dict" "$@" \
     "$scratch/corpus" "$source/tests/fuzz/seeds" "$source/tests/corpus/gltf" >"$scratch/log.txt" 2>&1
 code=$?
 grep -E '^(#[0-9]+ +(INITED|DONE)|stat::number_of_executed_units|stat::peak_rss_mb|Done [0-9]+ runs)' "$scratch/log.txt"
