@@ -429,10 +429,7 @@ Status Baker::Impl::init(const Scene& scene) {
     glFinish();
     stats.secondsEmitters = secondsSince(te);
     auto ts = Clock::now();
-    if (!lights.empty()) {
-        bakeSun();
-        foldDirect(true);
-    }
+    bakeSun();
     glFinish();
     stats.secondsSun = secondsSince(ts);
     auto tr = Clock::now();

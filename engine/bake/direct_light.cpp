@@ -42,6 +42,7 @@ void Baker::Impl::bakeSun() {
                 tracer->run(bundleFrame(glm::normalize(lights[li].direction), jitter, sunOptions.uniform, jitterUnit),
                             sunOptions, uint32_t(li * 1000 + jy * j + jx), false, update);
             }
+        foldDirect(true);  // this sun's mean over its valid samples, added to the direct map
     }
 }
 

@@ -7,9 +7,8 @@
 uniform int viewportPixels;   // the viewport's side: a power of two >= leafPixels
 uniform float subpixelSteps;  // 2^GL_SUBPIXEL_BITS
 
-// The whole triangle, for the plane equations below (bound in chunks, as
-// triangles[]: vertex 3t + k of the mesh is vertices[3 (t - meshChunkFirstTriangle) + k]).
-layout(std430, binding = BINDING_VERTICES) readonly buffer Vertices { BakeVertex vertices[]; };
+// The whole triangle, for the plane equations below, and its side.
+#include "lib/triangle_side.glsl"
 
 // Depth and light map uv as planes over the leaf's pixel grid: value =
 // dot(plane.xy, pixel centre) + plane.z. Every vertex of a triangle computes
@@ -67,6 +66,6 @@ void main() {
     uvec4 tri = bakeTriangle(t);
     vPage = tri.y;
     vFlags = tri.w;
-    vFaceNormal = inNormal.xyz;
+    vFaceNormal = triangleSide(t);
     vTriangle = t;  // gl_PrimitiveID restarts with each draw of a multi-draw
 }

@@ -26,6 +26,7 @@ in vec3 vPosition;
 in vec3 vNormal;
 flat in uint vFlags;
 flat in uint vPage;
+flat in vec3 vSide;
 
 layout(binding = BINDING_HEADS, r32ui) uniform readonly uimage2D heads;
 layout(std430, binding = BINDING_NODES) readonly buffer Nodes { Node nodes[]; };
@@ -70,8 +71,9 @@ void main() {
     // spin; they have no side effects to make, so leave at once (GLSL 4.50).
     if (gl_HelperInvocation) return;
     vec3 n = normalize(vNormal);
+    // the triangle's plane, on the side the bundle pass gives its fragments
     vec3 ng = length(faceNormal) > 0.0 ? normalize(faceNormal) : n;
-    if (dot(ng, n) < 0.0) ng = -ng;
+    if (dot(ng, vSide) < 0.0) ng = -ng;
     vec3 b = bundleFromWorld(vPosition);
     vec2 q = rootFromBundle(b.xy);
     if (!leafOwns(q)) return;  // another leaf's
@@ -79,8 +81,13 @@ void main() {
     ivec2 pixel = min(ivec2(floor(g)), ivec2(leafPixels - 1)) - tileOffset;
     if (any(lessThan(pixel, ivec2(0))) || any(greaterThanEqual(pixel, tileSize))) return;  // another tile's
 
+    // The side the texel looks to is its triangle's (ng, the side the bundle
+    // pass gives the triangle's own fragments); its shading normal n weighs the
+    // sample (cosine), and a direction below n's horizon adds nothing.
+    bool ahead = dot(ng, bundleDir) > 0.0;  // the texel looks along +d
     float c = dot(n, bundleDir);
-    bool ahead = c > 0.0;  // the texel looks along +d
+    float cosine = ahead ? c : -c;
+    if (cosine <= 0.0) return;
     uint ownSide = ahead ? NODE_VISIBLE_FROM_AHEAD : NODE_VISIBLE_FROM_BEHIND;
     uint seenSide = ahead ? NODE_VISIBLE_FROM_BEHIND : NODE_VISIBLE_FROM_AHEAD;
     // The ray through the pixel centre passes r (up to half a pixel diagonal)
@@ -140,7 +147,7 @@ void main() {
     // the sun pass's d is the light's travel direction: a texel facing the sun looks along -d
     // a valid sample: sums += lit irradiance * cos / pi, count += 1 (exact in fp16 to 2048)
     if (ahead) return;
-    addDirect(texel, bestNode == END_OF_LIST ? sunIrradiance * (-c) / PI : vec3(0.0));
+    addDirect(texel, bestNode == END_OF_LIST ? sunIrradiance * cosine / PI : vec3(0.0));
     vec4 d = imageLoad(directMap, texel);
     imageStore(directMap, texel, vec4(d.rgb, d.a + 1.0));
 #else
@@ -155,7 +162,7 @@ void main() {
     // stored: the running cosine-weighted mean of L_in (rgb) and its weight W (a)
     vec4 state = vec4(halfToFloat(stored.x), halfToFloat(stored.x >> 16u), halfToFloat(stored.y),
                       halfToFloat(stored.y >> 16u));
-    float w = sampleWeight * abs(c);
+    float w = sampleWeight * cosine;
     float total = state.a + w;
     vec4 sum = vec4(state.rgb + (incoming - state.rgb) * (w / total), total);
     uint h = pcgHash(randomSeed ^ pcgHash(uint(texel.x) | (uint(texel.y) << 16u)) ^ pcgHash(vPage + 7919u));
