@@ -241,6 +241,7 @@ Status Baker::Impl::init(const Scene& scene) {
         textureMeans.push_back(t.texels.empty() ? glm::vec3(1.0f) : glm::vec3(sum / double(t.texels.size())));
     }
     lights = scene.lights;
+    inputKey = hashInputs(scene);
     stats.directionsTotal = options.directions;
     if (options.directions < 1) return Status::error("--directions must be at least 1");
     if (mesh.triangles.empty()) return Status::error("nothing to bake: the scene has no triangles");

@@ -25,6 +25,7 @@ struct Baker::Impl {
     std::vector<Material> materials;
     std::vector<DirectionalLight> lights;
     BakeStats stats;
+    uint64_t inputKey = 0;  // hash of the materials, their textures and the lights (checkpoints)
     std::vector<glm::vec3> directions;
 
     // scene frame
@@ -74,6 +75,7 @@ struct Baker::Impl {
     BundleTracer::UpdateFn directionUpdate;
 
     Status init(const Scene& scene);
+    static uint64_t hashInputs(const Scene& scene);  // inputKey (checkpoint.cpp)
     Status buildPrograms();
     void uploadMesh();
     void uploadMaterials(const Scene& scene);

@@ -17,7 +17,7 @@
 namespace bb {
 
 namespace {
-constexpr char CHECKPOINT_MAGIC[8] = {'B', 'B', 'C', 'K', 'P', 'T', '0', '3'};
+constexpr char CHECKPOINT_MAGIC[8] = {'B', 'B', 'C', 'K', 'P', 'T', '0', '4'};
 
 uint64_t fnv1a(const void* data, size_t bytes, uint64_t h = 1469598103934665603ull) {
     const auto* p = static_cast<const uint8_t*>(data);
@@ -26,16 +26,54 @@ uint64_t fnv1a(const void* data, size_t bytes, uint64_t h = 1469598103934665603u
 }
 
 // What a checkpoint must match to be resumed: geometry, layout and every option that changes the bytes.
-uint64_t checkpointKey(const BakeMesh& mesh, const Layout& layout, const BakeOptions& o, double historyPower) {
+uint64_t checkpointKey(const Baker::Impl& m) {
+    const BakeMesh& mesh = m.mesh;
+    const BakeOptions& o = m.options;
     uint64_t h = fnv1a(mesh.vertices.data(), mesh.vertices.size() * sizeof(BakeVertex));
     h = fnv1a(mesh.triangles.data(), mesh.triangles.size() * sizeof(BakeTriangle), h);
-    const int64_t ints[] = {layout.resolution, layout.pageCount, o.directions, o.bundleResolution, o.memoryBudget, int64_t(o.tiling),
-                            int64_t(o.seed), int64_t(o.rounding), o.sunJitter, o.environment ? 1 : 0};
+    // not the memory budget: the bytes do not depend on it (tiling_bake_test), so a bake may resume with another
+    const int64_t ints[] = {m.layout.resolution, m.layout.pageCount, o.directions, o.bundleResolution,
+                            int64_t(o.tiling), int64_t(o.seed), int64_t(o.rounding), o.sunJitter,
+                            o.environment ? 1 : 0, int64_t(o.directLight), o.emitterSamples, o.emitterShadowSize};
     h = fnv1a(ints, sizeof ints, h);
-    const double reals[] = {o.sky.r, o.sky.g, o.sky.b, historyPower};
+    const double reals[] = {o.sky.r, o.sky.g, o.sky.b, m.historyPower};
     h = fnv1a(reals, sizeof reals, h);
     if (o.environment) h = fnv1a(o.environment->pixels.data(), o.environment->pixels.size() * sizeof(glm::vec3), h);
-    return h;
+    return fnv1a(&m.inputKey, sizeof m.inputKey, h);  // materials, their textures, lights
+}
+
+// The counters stats.json reports, carried over a resume.
+nlohmann::json statsCounters(const BakeStats& s) {
+    return {{"tiles_drawn", s.tilesDrawn}, {"overflows", s.overflows}, {"fragments", s.fragments},
+            {"updated_texels", s.updatedTexels}, {"peak_nodes_per_tile", s.peakNodesPerTile},
+            {"bundle_triangles_drawn", s.bundleTrianglesDrawn}, {"update_triangles_drawn", s.updateTrianglesDrawn},
+            {"seconds", {s.secondsTiling, s.secondsBundle, s.secondsUpdate, s.secondsResolve}},
+            {"predicted_over_actual", s.predictedOverActual}, {"tiles_per_direction", s.tilesPerDirection},
+            {"leaves_per_direction", s.leavesPerDirection}, {"tile_pixel_sizes", s.tilePixelSizes}};
+}
+
+bool restoreStatsCounters(const nlohmann::json& j, BakeStats& s) {
+    try {
+        s.tilesDrawn = j.at("tiles_drawn");
+        s.overflows = j.at("overflows");
+        s.fragments = j.at("fragments");
+        s.updatedTexels = j.at("updated_texels");
+        s.peakNodesPerTile = j.at("peak_nodes_per_tile");
+        s.bundleTrianglesDrawn = j.at("bundle_triangles_drawn");
+        s.updateTrianglesDrawn = j.at("update_triangles_drawn");
+        const auto& t = j.at("seconds");
+        s.secondsTiling = t.at(0);
+        s.secondsBundle = t.at(1);
+        s.secondsUpdate = t.at(2);
+        s.secondsResolve = t.at(3);
+        s.predictedOverActual = j.at("predicted_over_actual").get<std::vector<double>>();
+        s.tilesPerDirection = j.at("tiles_per_direction").get<std::vector<int>>();
+        s.leavesPerDirection = j.at("leaves_per_direction").get<std::vector<int>>();
+        s.tilePixelSizes = j.at("tile_pixel_sizes").get<std::vector<float>>();
+        return true;
+    } catch (const nlohmann::json::exception&) {
+        return false;
+    }
 }
 
 struct CheckpointHeader {
@@ -49,6 +87,22 @@ struct CheckpointHeader {
 };
 }  // namespace
 
+uint64_t Baker::Impl::hashInputs(const Scene& scene) {
+    uint64_t h = fnv1a(nullptr, 0);
+    for (const Material& mat : scene.materials) {
+        const float values[] = {mat.albedo.r, mat.albedo.g, mat.albedo.b, mat.emission.r, mat.emission.g, mat.emission.b};
+        const int32_t ints[] = {mat.albedoTexture, mat.emissionTexture, mat.doubleSided ? 1 : 0};
+        h = fnv1a(values, sizeof values, h);
+        h = fnv1a(ints, sizeof ints, h);
+    }
+    for (const Texture& t : scene.textures) h = fnv1a(t.texels.data(), t.texels.size() * sizeof(glm::vec4), h);
+    for (const DirectionalLight& l : scene.lights) {
+        const float values[] = {l.direction.x, l.direction.y, l.direction.z, l.irradiance.r, l.irradiance.g, l.irradiance.b};
+        h = fnv1a(values, sizeof values, h);
+    }
+    return h;
+}
+
 Status Baker::saveCheckpoint(const std::string& path) {
     Impl& m = *impl_;
     // a checkpoint holds whole directions: finish the one in flight (the same tiles an uninterrupted bake draws)
@@ -59,7 +113,7 @@ Status Baker::saveCheckpoint(const std::string& path) {
     gl::readTexture(m.accum.id(), 0, 0, 0, res, res, pages, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
     CheckpointHeader h{};
     std::memcpy(h.magic, CHECKPOINT_MAGIC, 8);
-    h.key = checkpointKey(m.mesh, m.layout, m.options, m.historyPower);
+    h.key = checkpointKey(m);
     h.directionsDone = m.stats.directionsDone;
     h.resolution = res;
     h.pages = m.layout.pageCount;
@@ -70,6 +124,11 @@ Status Baker::saveCheckpoint(const std::string& path) {
     std::string bytes(reinterpret_cast<const char*>(&h), sizeof h);
     bytes.append(reinterpret_cast<const char*>(raw.data()), raw.size() * sizeof(glm::uvec2));
     bytes.append(reinterpret_cast<const char*>(radiance.data()), radiance.size() * sizeof(uint32_t));
+    // then the statistics so far (JSON, length first: doubles round-trip exactly)
+    const std::string counters = statsCounters(m.stats).dump();
+    const uint64_t countersBytes = counters.size();
+    bytes.append(reinterpret_cast<const char*>(&countersBytes), sizeof countersBytes);
+    bytes.append(counters);
     return io::writeFileAtomic(path, bytes);
 }
 
@@ -80,7 +139,7 @@ Status Baker::loadCheckpoint(const std::string& path) {
     CheckpointHeader h{};
     const int res = m.layout.resolution;
     const size_t texels = size_t(res) * res * m.layout.pageCount;
-    const size_t expectedBytes = sizeof h + texels * (sizeof(glm::uvec2) + sizeof(uint32_t));
+    const size_t mapBytes = sizeof h + texels * (sizeof(glm::uvec2) + sizeof(uint32_t));
     // every way a file can fail to be this layout's checkpoint, said before anything is read into GL
     const bool headerRead = std::fread(&h, sizeof h, 1, f) == 1;
     size_t fileBytes = 0;
@@ -98,23 +157,34 @@ Status Baker::loadCheckpoint(const std::string& path) {
     if (h.resolution != res || h.pages != m.layout.pageCount)
         return refuse("it holds " + std::to_string(h.pages) + " page(s) of " + std::to_string(h.resolution) + "^2, this bake " +
                       std::to_string(m.layout.pageCount) + " of " + std::to_string(res) + "^2");
-    if (fileBytes != expectedBytes)
-        return refuse(std::to_string(fileBytes) + " bytes where this layout's checkpoint has " + std::to_string(expectedBytes));
+    uint64_t countersBytes = 0;
+    if (fileBytes < mapBytes + sizeof countersBytes || std::fseek(f, long(mapBytes), SEEK_SET) != 0 ||
+        std::fread(&countersBytes, sizeof countersBytes, 1, f) != 1 ||
+        fileBytes - mapBytes - sizeof countersBytes != countersBytes)
+        return refuse(std::to_string(fileBytes) + " bytes, which is not this layout's light maps (" +
+                      std::to_string(mapBytes) + " bytes) and their statistics");
     if (!(std::isfinite(h.accumScale) && h.accumScale > 0.0)) return refuse("corrupt accumulator scale");
     std::vector<glm::uvec2> raw(texels);
     std::vector<uint32_t> radiance(texels);
     const bool ok = std::fseek(f, long(sizeof h), SEEK_SET) == 0 &&
                     std::fread(raw.data(), sizeof(glm::uvec2), raw.size(), f) == raw.size() &&
                     std::fread(radiance.data(), sizeof(uint32_t), radiance.size(), f) == radiance.size();
+    std::string counters(countersBytes, '\0');
+    const bool countersRead = ok && std::fseek(f, long(mapBytes + sizeof countersBytes), SEEK_SET) == 0 &&
+                              std::fread(counters.data(), 1, counters.size(), f) == counters.size();
     std::fclose(f);
-    if (!ok) return Status::error("cannot read checkpoint " + path);
-    if (h.key != checkpointKey(m.mesh, m.layout, m.options, m.historyPower))
+    if (!ok || !countersRead) return Status::error("cannot read checkpoint " + path);
+    BakeStats restored = m.stats;
+    if (!restoreStatsCounters(nlohmann::json::parse(counters, nullptr, false), restored))
+        return Status::error(path + ": corrupt statistics (remove it or bake without --resume)");
+    if (h.key != checkpointKey(m))
         return Status::error(path + " was written for another scene or other bake options; remove it or bake without --resume");
     if (h.directionsDone < 0 || h.directionsDone > m.options.directions)
         return Status::error(path + ": corrupt progress count");
     gl::writeTexture(m.accum.id(), 0, 0, 0, res, res, m.layout.pageCount, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
     gl::writeTexture(m.radianceBits.id(), 0, 0, 0, res, res, m.layout.pageCount, GL_RED_INTEGER, GL_UNSIGNED_INT, 4,
                      radiance.data());
+    m.stats = restored;
     m.stats.directionsDone = h.directionsDone;
     m.accumScale = h.accumScale;
     return Status::ok();

@@ -2,7 +2,10 @@
 // EXR pages + manifest.json + stats.json + tone-mapped PNG previews.
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cstdlib>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 
@@ -14,6 +17,13 @@
 #include "headless/platform.h"
 
 namespace bb::cli {
+namespace {
+// Checkpoints left before the test hook kills the process (parsed once).
+int& killCountdown(const char* value) {
+    static int left = std::max(1, std::atoi(value));
+    return left;
+}
+}  // namespace
 
 void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
     addSceneOptions(cmd, a.scene);
@@ -116,11 +126,15 @@ int runBake(const BakeArgs& args) {
     auto t0 = std::chrono::steady_clock::now();
     int lastCheckpoint = (*baker)->progress().directionsDone;
     while (true) {
-        BakeProgress p = (*baker)->step(0.25);
+        // one direction at a time when checkpointing: a checkpoint every N directions exactly
+        BakeProgress p = (*baker)->step(args.checkpointEvery > 0 ? 0.0 : 0.25);
         bar.update(p.directionsDone, p.directionsTotal);
         if (args.checkpointEvery > 0 && p.directionsDone - lastCheckpoint >= args.checkpointEvery && !p.done()) {
             if (Status s = (*baker)->saveCheckpoint(checkpoint); !s) return fail(s.message());
             lastCheckpoint = p.directionsDone;
+            // test hook: die as `kill -9` would, right after the n-th checkpoint (tests/gl/cli_resume_test.cpp)
+            if (const char* n = std::getenv("BUNDLEBAKE_TEST_KILL_AFTER_CHECKPOINTS"); n && --killCountdown(n) == 0)
+                std::raise(SIGKILL);
         }
         if (p.done()) break;
     }
