@@ -56,9 +56,11 @@ uint16_t floatToHalf(float x, Rounding mode, float u) {
 float halfToFloat(uint16_t h) { return imath_half_to_float(h); }
 
 uint32_t encodeRgbe(glm::vec3 rgb, Rounding mode, glm::vec3 u) {
-    // negatives and NaN -> 0 (the comparison is false for NaN); +Inf -> the
-    // largest float, which then saturates below like any value >= 2^127
-    for (int i = 0; i < 3; ++i) rgb[i] = rgb[i] > 0.0f ? std::min(rgb[i], std::numeric_limits<float>::max()) : 0.0f;
+    // negatives, NaN and denormals -> 0 (the comparison is false for NaN;
+    // GPUs may flush denormals, so the GLSL twin could not keep them); +Inf ->
+    // the largest float, which then saturates below like any value >= 2^127
+    for (int i = 0; i < 3; ++i)
+        rgb[i] = rgb[i] >= std::numeric_limits<float>::min() ? std::min(rgb[i], std::numeric_limits<float>::max()) : 0.0f;
     const float maxc = std::max(rgb.r, std::max(rgb.g, rgb.b));
     if (!(maxc >= 1e-38f)) return 0;
     if (mode == Rounding::Nearest) u = glm::vec3(0.5f);

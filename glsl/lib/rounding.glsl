@@ -35,22 +35,26 @@ float halfToFloat(uint h) { return unpackHalf2x16(h & 0xFFFFu).x; }
 
 // RGBE: mantissas in bits 0..23, exponent byte in 24..31; value = m * 2^(e - 136).
 uint encodeRgbe(vec3 c, vec3 u) {
-    c = max(c, vec3(0.0));
+    // the C++ twin's rules (engine/bake/rounding.cpp), step for step:
+    // negatives, NaN and denormals -> 0; +Inf -> the largest float, which saturates below
+    for (int i = 0; i < 3; ++i) c[i] = c[i] >= 1.17549435e-38 ? min(c[i], 3.40282347e38) : 0.0;
     float m = max(c.r, max(c.g, c.b));
     if (!(m >= 1e-38)) return 0u;
-    int e;
-    frexp(m, e);  // m = f * 2^e, f in [0.5, 1)
 #ifdef ROUNDING_NEAREST
     u = vec3(0.5);
 #endif
+    int e;
+    frexp(m, e);  // m = f * 2^e, f in [0.5, 1)
     for (int attempt = 0; attempt < 2; ++attempt) {
-        vec3 scaled = c * exp2(float(8 - e));
-        uvec3 q = uvec3(floor(scaled + u));
+        int es = min(e, 127);  // the largest exponent byte; beyond it the mantissas saturate
+        // ldexp, not c * exp2(8 - e): 2^(8 - e) overflows a float for m < 2^-120
+        uvec3 q = uvec3(floor(min(vec3(ldexp(c.r, 8 - es), ldexp(c.g, 8 - es), ldexp(c.b, 8 - es)), vec3(256.0)) + u));
+        if (e > 127) q = min(q, uvec3(255u));
         if (max(q.r, max(q.g, q.b)) < 256u) {
-            int eb = clamp(e + 128, 0, 255);
+            int eb = clamp(es + 128, 0, 255);
             return q.r | (q.g << 8u) | (q.b << 16u) | (uint(eb) << 24u);
         }
-        e += 1;
+        e += 1;  // a mantissa rounded up to 256: carry into the exponent and round again
     }
     return 0u;
 }

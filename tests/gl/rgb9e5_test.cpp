@@ -1,7 +1,9 @@
-// The outgoing radiance map's RGB9E5 encoder (glsl/lib/rounding.glsl), written
-// through an r32ui view and read back as GL decodes GL_RGB9_E5: its bits are
-// GL's, nearest rounding stays within half a step, special values are safe,
-// and stochastic rounding is unbiased.
+// The GPU's radiance encoders (glsl/lib/rounding.glsl). RGB9E5 (the outgoing
+// radiance map), written through an r32ui view and read back as GL decodes
+// GL_RGB9_E5: its bits are GL's, nearest rounding stays within half a step,
+// special values are safe, stochastic rounding is unbiased. RGBE (the nodes):
+// the same bits as its C++ twin (engine/bake/rounding.cpp) on every input,
+// special values included.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,6 +13,7 @@
 #include <glm/glm.hpp>
 
 #include "gl/objects.h"
+#include "bake/rounding.h"
 #include "gl/shader.h"
 #include "support/gl_fixture.h"
 
@@ -92,6 +95,51 @@ TEST(Rgb9e5, StochasticRoundingIsUnbiased) {
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(mean[c], value[c], 2.0 * s / n + 1e-7 * value[c]) << "channel " << c;
     // and it does round both ways (0.0123 sits between two steps far apart relative to it)
     EXPECT_NE(out.front().g, out.back().g);
+}
+
+TEST(Rgbe, GpuEncoderGivesTheCppTwinsBitsOnEveryInput) {
+    BB_REQUIRE_GL();
+    const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+    const float big = std::numeric_limits<float>::max();
+    std::vector<glm::vec4> values, us;
+    const float specials[] = {0.0f, -0.0f, -1.0f, nan, inf, -inf, big, 1e38f, 3e38f, 2e-38f, 5e-39f,
+                              1e-30f, 1.0f, 0.5f, 255.5f, 255.99f, 256.0f, 65504.0f, 1e6f, 0.1f, 3.0f};
+    for (float a : specials)
+        for (float b : {0.0f, 1.0f, a, nan, inf})
+            for (float u : {0.0f, 0.5f, 0.999f}) {
+                values.push_back(glm::vec4(a, b, 0.25f * a, 0.0f));
+                us.push_back(glm::vec4(u, 1.0f - u, 0.5f, 0.0f));
+            }
+    // ordinary values, mantissas near the rounding carry, random u
+    for (int i = 0; i < 2000; ++i) {
+        const float x = std::ldexp(1.0f + float(i % 97) / 97.0f, i % 60 - 30);
+        values.push_back(glm::vec4(x, x * 0.999f, x * float(i % 13) / 13.0f, 0.0f));
+        us.push_back(glm::vec4(float(i % 101) / 101.0f, float(i % 89) / 89.0f, float(i % 83) / 83.0f, 0.0f));
+    }
+    auto program = gl::buildProgram({"test/rgbe.comp"});
+    ASSERT_TRUE(program) << program.error();
+    const int n = int(values.size());
+    gl::Buffer bv = gl::Buffer::create("rgbe test values", int64_t(n) * 16, values.data(), 0);
+    gl::Buffer bu = gl::Buffer::create("rgbe test u", int64_t(n) * 16, us.data(), 0);
+    gl::Buffer bo = gl::Buffer::create("rgbe test out", int64_t(n) * 4, nullptr, 0);
+    glUseProgram(program->id());
+    glUniform1i(program->uniform("count"), n);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, bv.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, bu.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, bo.id());
+    glDispatchCompute(GLuint(n + 63) / 64, 1, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    std::vector<uint32_t> gpu(size_t(n), 0);
+    glGetNamedBufferSubData(bo.id(), 0, GLsizeiptr(n) * 4, gpu.data());
+    int mismatches = 0;
+    for (int i = 0; i < n; ++i) {
+        const uint32_t cpu = encodeRgbe(glm::vec3(values[size_t(i)]), Rounding::Stochastic, glm::vec3(us[size_t(i)]));
+        if (gpu[size_t(i)] != cpu && ++mismatches <= 10)
+            ADD_FAILURE() << "input (" << values[size_t(i)].x << ", " << values[size_t(i)].y << ", " << values[size_t(i)].z
+                          << ") u (" << us[size_t(i)].x << ", " << us[size_t(i)].y << ", " << us[size_t(i)].z
+                          << "): GPU " << std::hex << gpu[size_t(i)] << ", C++ " << cpu;
+    }
+    EXPECT_EQ(mismatches, 0) << "of " << n << " inputs";
 }
 
 }  // namespace

@@ -191,13 +191,15 @@ TEST(Rounding, RgbeZeroTinyNegativeAndCarry) {
         EXPECT_EQ(mixed, glm::vec3(0.0f, 2.0f, 0.0f));
     }
     // tiny but representable: still 8 bits of relative precision (the GLSL
-    // exp2(8 - e) form would overflow here)
-    for (float x : {1.0e-30f, 2.0e-38f, 3.0e-37f}) {
+    // exp2(8 - e) form would overflow here); denormal channels are zero (GPUs
+    // may flush them)
+    for (float x : {1.0e-30f, 2.5e-38f, 3.0e-37f}) {
         const glm::vec3 d = decodeRgbe(encodeRgbe(glm::vec3(x, x * 0.5f, 0.0f), Rounding::Nearest, glm::vec3(0.0f)));
         EXPECT_NEAR(d.r, x, x / 128.0f);
         EXPECT_NEAR(d.g, x * 0.5f, x / 256.0f);
         EXPECT_EQ(d.b, 0.0f);
     }
+    EXPECT_EQ(decodeRgbe(encodeRgbe(glm::vec3(2.0e-38f, 1.0e-38f, 0.0f), Rounding::Nearest, glm::vec3(0.0f))).g, 0.0f);
     // exact values round-trip exactly: m * 2^(e - 136)
     EXPECT_EQ(decodeRgbe(encodeRgbe(glm::vec3(1.0f, 0.5f, 0.25f), Rounding::Nearest, glm::vec3(0.0f))),
               glm::vec3(1.0f, 0.5f, 0.25f));
