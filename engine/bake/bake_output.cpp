@@ -48,7 +48,7 @@ Status writeBakeOutputs(const std::string& outDir, const Scene& scene, const Lay
     nlohmann::json pages = nlohmann::json::array();
     for (size_t p = 0; p < maps.pages.size(); ++p) {
         std::string exr = lightmapFileName(int(p));
-        if (Status s = io::writeExrHalf(outDir + "/" + exr, maps.pages[p], {{"bundlebake:units", units}}); !s) return s;
+        if (Status s = io::writeExr(outDir + "/" + exr, maps.pages[p], {{"bundlebake:units", units}}); !s) return s;
         nlohmann::json page = {{"page", p}, {"exr", exr}};
         if (p < maps.covered.size()) {
             io::ImageRgb mask;

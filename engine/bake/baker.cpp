@@ -65,7 +65,7 @@ nlohmann::json BakeStats::toJson() const {
     nlohmann::json j;
     j["directions"] = {{"done", directionsDone}, {"total", directionsTotal}};
     j["bundle"] = {{"resolution_pixels", bundleResolution}, {"pixel_size_scene_units", pixelSize},
-                   {"history_power", historyPower}};
+                   {"history_power", historyPower}, {"radiance_unit", radianceUnit}};
     auto pct = [&](double q) { return quantile(predictedOverActual, q); };
     auto size = [&](double q) { return quantile(tilePixelSizes, q); };
     int maxTiles = tilesPerDirection.empty() ? 0 : *std::max_element(tilesPerDirection.begin(), tilesPerDirection.end());
@@ -199,7 +199,8 @@ void Baker::Impl::drawSurface(GLuint program, bool materialUniforms) {
         if (materialUniforms) {
             const Material& mat = materials[run.material];
             glUniform3fv(glGetUniformLocation(program, "albedo"), 1, &mat.albedo.x);
-            glUniform3fv(glGetUniformLocation(program, "emission"), 1, &mat.emission.x);
+            const glm::vec3 emission = mat.emission / radianceUnit;
+            glUniform3fv(glGetUniformLocation(program, "emission"), 1, &emission.x);
             glUniform1i(glGetUniformLocation(program, "hasAlbedoTexture"), mat.albedoTexture >= 0);
             glUniform1i(glGetUniformLocation(program, "hasEmissionTexture"), mat.emissionTexture >= 0);
             if (mat.albedoTexture >= 0) glBindTextureUnit(BINDING_MATERIAL_TEX, materialTextures[mat.albedoTexture].id());
@@ -230,6 +231,53 @@ void Baker::Impl::coveragePass() {
         gl::writeTexture(dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, codes.data());
     }
     stats.lightmapTexels = int64_t(res) * res * layout.pageCount;
+}
+
+void Baker::Impl::sanitizeInputs(const Scene& scene) {
+    // inputs the passes cannot take: one warning each, then read as 0 (or 1 for albedo)
+    float rhoMax = 0.0f;
+    for (Material& m : materials) {
+        if (!(glm::all(glm::greaterThanEqual(m.emission, glm::vec3(0.0f))) && std::isfinite(glm::length(m.emission)))) {
+            logWarning("material " + m.name + ": emission not finite and >= 0; baked as 0");
+            m.emission = glm::vec3(0.0f);
+        }
+        if (glm::any(glm::greaterThan(m.albedo, glm::vec3(1.0f))))
+            logWarning("material " + m.name + ": albedo above 1 (energy would grow with each bounce); clamped to 1");
+        m.albedo = glm::clamp(m.albedo, 0.0f, 1.0f);
+        if (!std::isfinite(m.albedo.r + m.albedo.g + m.albedo.b)) m.albedo = glm::vec3(0.0f);
+        rhoMax = std::max({rhoMax, m.albedo.r, m.albedo.g, m.albedo.b});
+    }
+    float peak = 0.0f;  // the brightest source radiance
+    for (const Material& m : materials) {
+        float texMax = 1.0f;
+        if (m.emissionTexture >= 0)
+            for (const glm::vec4& t : scene.textures[size_t(m.emissionTexture)].texels) texMax = std::max({texMax, t.r, t.g, t.b});
+        peak = std::max(peak, std::max({m.emission.r, m.emission.g, m.emission.b}) * texMax);
+    }
+    peak = std::max({peak, options.sky.r, options.sky.g, options.sky.b});
+    for (const DirectionalLight& l : lights)
+        peak = std::max(peak, std::max({l.irradiance.r, l.irradiance.g, l.irradiance.b}) / 3.14159265f);
+    if (options.environment) {
+        size_t bad = 0;
+        for (glm::vec3& p : options.environment->pixels)
+            for (int c = 0; c < 3; ++c) {
+                if (!(p[c] >= 0.0f && std::isfinite(p[c]))) {
+                    p[c] = 0.0f;
+                    ++bad;
+                }
+                peak = std::max(peak, p[c]);
+            }
+        if (bad) logWarning(std::to_string(bad) + " environment values are NaN, infinite or negative; read as 0");
+    }
+    // The light-map state (fp16, RGB9E5) holds radiance / radianceUnit: a power
+    // of two that keeps the brightest light map value expected, the brightest
+    // source after every bounce (/ (1 - rho_max)), below 2^12 (16x under the
+    // fp16 maximum) and the brightest source above 2^-10 (fp16 normals below).
+    // 1 for every scene between: their bytes do not change. Exact (a power of two).
+    const double expected = double(peak) / (1.0 - std::min(double(rhoMax), 0.999));
+    radianceUnit = 1.0f;
+    if (expected > 4096.0) radianceUnit = std::ldexp(1.0f, int(std::ceil(std::log2(expected))) - 12);
+    else if (peak > 0.0f && peak < 1.0f / 1024.0f) radianceUnit = std::ldexp(1.0f, int(std::floor(std::log2(double(peak)))));
 }
 
 Status Baker::Impl::init(const Scene& scene) {
@@ -323,6 +371,8 @@ Status Baker::Impl::init(const Scene& scene) {
     }
     stats.historyPower = historyPower;
     directions = makeDirections(options.directions, options.seed);
+    sanitizeInputs(scene);
+    stats.radianceUnit = radianceUnit;
 
     Status s = buildPrograms();
     if (!s) return s;
@@ -355,7 +405,7 @@ Status Baker::Impl::init(const Scene& scene) {
         const auto& env = *options.environment;
         envTexture = gl::Texture::create2D("environment", GL_RGBA32F, env.width, env.height);
         std::vector<glm::vec4> rgba(env.pixels.size());
-        for (size_t i = 0; i < rgba.size(); ++i) rgba[i] = glm::vec4(env.pixels[i], 1.0f);
+        for (size_t i = 0; i < rgba.size(); ++i) rgba[i] = glm::vec4(env.pixels[i] / radianceUnit, 1.0f);
         // file row 0 is the top (theta = 0): texture t = theta / pi, so upload rows top-down as t = 0..1
         glTextureSubImage2D(envTexture.id(), 0, 0, 0, env.width, env.height, GL_RGBA, GL_FLOAT, rgba.data());
         glTextureParameteri(envTexture.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
@@ -553,8 +603,9 @@ std::vector<std::vector<glm::vec4>> Baker::readAccumulators() {
     for (int p = 0; p < m.layout.pageCount; ++p) {
         gl::readTexture(m.accum.id(), 0, 0, p, res, res, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
         for (const glm::uvec2& v : raw)
-            out[size_t(p)].push_back(glm::vec4(halfToFloat(uint16_t(v.x & 0xFFFF)), halfToFloat(uint16_t(v.x >> 16)),
-                                               halfToFloat(uint16_t(v.y & 0xFFFF)), halfToFloat(uint16_t(v.y >> 16))));
+            out[size_t(p)].push_back(glm::vec4(glm::vec3(halfToFloat(uint16_t(v.x & 0xFFFF)), halfToFloat(uint16_t(v.x >> 16)),
+                                                         halfToFloat(uint16_t(v.y & 0xFFFF))) * m.radianceUnit,
+                                               halfToFloat(uint16_t(v.y >> 16))));
     }
     return out;
 }
@@ -608,7 +659,7 @@ Baker::BundleCapture Baker::captureBundle(const glm::vec3& dir) {
             for (auto& [z, i] : list) {
                 cap.depths[k].push_back(z);
                 cap.flags[k].push_back(nodes[i].depth & NODE_FLAG_MASK);
-                cap.radiance[k].push_back(decodeRgbe(nodes[i].radiance));
+                cap.radiance[k].push_back(decodeRgbe(nodes[i].radiance) * m.radianceUnit);
             }
         }
     return cap;

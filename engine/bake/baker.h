@@ -80,6 +80,7 @@ struct BakeStats {
     double bundleResolution = 0;      // pixels across the bounding sphere (the uniform grid)
     double pixelSize = 0;             // scene units (the uniform grid's; tiles: tilePixelSizes)
     double historyPower = 0;
+    double radianceUnit = 1;          // the light-map state holds radiance / this (a power of two; fp16 range)
     int64_t tilesDrawn = 0;
     int64_t overflows = 0;            // tile draws whose node count exceeded the buffer: redrawn (bigger buffer, or split)
     int64_t fragments = 0;            // nodes appended (kept), over all tiles

@@ -38,6 +38,7 @@ struct Baker::Impl {
     float depthBias = 0.0f;
     double historyPower = 0.0;
     double accumScale = 1.0;  // stored sums are true sums / accumScale
+    float radianceUnit = 1.0f;  // the light-map state holds radiance / radianceUnit (sanitizeInputs)
     std::vector<double> projectedArea;  // per triangle world area
     std::vector<Cluster> clusters;      // the mesh in culling units (engine/tiler)
     TilerOptions tilerOptions;
@@ -76,6 +77,8 @@ struct Baker::Impl {
 
     Status init(const Scene& scene);
     static uint64_t hashInputs(const Scene& scene);  // inputKey (checkpoint.cpp)
+    // Bad emission, albedo and environment values warned about and replaced; radianceUnit.
+    void sanitizeInputs(const Scene& scene);
     Status buildPrograms();
     void uploadMesh();
     void uploadMaterials(const Scene& scene);

@@ -26,7 +26,7 @@ void Baker::Impl::bakeSun() {
     if (sunPixelSize > 0) sunOptions.fixedPixelSize = sunPixelSize;
     const double jitterUnit = sunPixelSize > 0 ? sunPixelSize : pixelSize;
     for (size_t li = 0; li < lights.size(); ++li) {
-        const glm::vec3 irradiance = lights[li].irradiance;
+        const glm::vec3 irradiance = lights[li].irradiance / radianceUnit;
         const BundleTracer::UpdateFn update = [&](const TileFrame&, uint32_t) -> GLuint {
             glUseProgram(sunProgram.id());
             glUniform3fv(sunProgram.uniform("sunIrradiance"), 1, &irradiance.x);
@@ -117,7 +117,7 @@ void Baker::Impl::bakeEmitters() {
         glm::vec3 a(v[0].position), b(v[1].position), c(v[2].position);
         glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
         bool doubleSided = mesh.triangles[e.triangle].flags & TRIANGLE_DOUBLE_SIDED;
-        glm::vec3 perSample = e.radiance / float(e.samples);
+        glm::vec3 perSample = e.radiance / (float(e.samples) * radianceUnit);
         for (int i = 0; i < e.samples; ++i) {
             // stratified point on the triangle: R2 sequence (Roberts 2018), folded
             double su = std::fmod(0.5 + 0.7548776662466927 * (i + 1), 1.0);

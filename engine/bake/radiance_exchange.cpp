@@ -41,7 +41,8 @@ void Baker::Impl::beginDirection(int k) {
         glUniform1f(updateProgram.uniform("sampleWeight"), float(sampleWeight));
         // per direction, not per tile: each texel is updated once per direction, and tiles change with the budget
         glUniform1ui(updateProgram.uniform("randomSeed"), seed);
-        glUniform3fv(updateProgram.uniform("sky"), 1, &options.sky.x);
+        const glm::vec3 sky = options.sky / radianceUnit;
+        glUniform3fv(updateProgram.uniform("sky"), 1, &sky.x);
         glUniform1i(updateProgram.uniform("useEnv"), useEnv);
         glUniform1f(updateProgram.uniform("depthBias"), depthBias);
         if (useEnv) glBindTextureUnit(BINDING_ENV, envTexture.id());
@@ -97,6 +98,7 @@ void Baker::Impl::resolveInto(const gl::Texture& target, int y0, int rows, int p
     glUniform3i(resolveProgram.uniform("origin"), 0, y0, page0);
     glUniform1i(resolveProgram.uniform("pageCount"), pages);
     glUniform2i(resolveProgram.uniform("pageSize"), layout.resolution, rows);
+    glUniform1f(resolveProgram.uniform("radianceUnit"), radianceUnit);
     glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RG32UI);
     glBindImageTexture(BINDING_DIRECT, direct.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
     glBindImageTexture(BINDING_DILATION, dilation.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_R8UI);

@@ -132,10 +132,13 @@ void flipRows(ImageRgb& image) {
     }
 }
 
-Status writeExrHalf(const std::string& path, const ImageRgb& image,
+Status writeExr(const std::string& path, const ImageRgb& image,
                     const std::vector<std::pair<std::string, std::string>>& attributes) {
     if (Status s = checkImage(image); !s) return Status::error("cannot write " + path + ": " + s.message());
-    OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::HALF);
+    // half, unless a value is beyond half's range (65504): then float, never a clamp
+    float largest = 0.0f;
+    for (const glm::vec3& p : image.pixels) largest = std::max({largest, p.r, p.g, p.b});
+    OIIO::ImageSpec spec(image.width, image.height, 3, largest > 65504.0f ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::HALF);
     spec.attribute("compression", "zip");
     // OIIO's EXR writer stamps the current time unless DateTime is set; an
     // empty one keeps the file a function of its pixels (determinism).

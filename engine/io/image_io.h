@@ -27,9 +27,10 @@ struct ImageRgb {
 
 void flipRows(ImageRgb& image);
 
-// Half-float RGB EXR (OpenEXR via OIIO), ZIP compression, plus string
-// attributes (e.g. "bundlebake:units" = "L_lm = E/pi").
-Status writeExrHalf(const std::string& path, const ImageRgb& image,
+// RGB EXR (OpenEXR via OIIO), ZIP compression, plus string attributes (e.g.
+// "bundlebake:units" = "L_lm = E/pi"): half floats, or 32-bit floats when a
+// value is beyond half's range (65504), so nothing is clamped.
+Status writeExr(const std::string& path, const ImageRgb& image,
                     const std::vector<std::pair<std::string, std::string>>& attributes = {});
 
 // Largest image readImageRgb accepts (width x height): 256 M pixels, e.g. a

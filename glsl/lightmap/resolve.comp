@@ -17,6 +17,7 @@ layout(binding = BINDING_TARGET, rgba32f) uniform writeonly image2DArray target;
 uniform ivec3 origin;
 uniform int pageCount;   // of the region
 uniform ivec2 pageSize;  // of the region
+uniform float radianceUnit;  // the state holds radiance / radianceUnit (Baker::Impl::radianceUnit)
 
 void main() {
     ivec3 g = ivec3(gl_GlobalInvocationID.xy, gl_GlobalInvocationID.z);
@@ -29,5 +30,5 @@ void main() {
     }
     uvec2 p = imageLoad(accum, s).rg;
     vec3 l = halfToFloat(p.y >> 16u) > 0.0 ? vec3(halfToFloat(p.x), halfToFloat(p.x >> 16u), halfToFloat(p.y)) : vec3(0.0);
-    imageStore(target, g, vec4(l + imageLoad(directMap, s).rgb, 1.0));
+    imageStore(target, g, vec4((l + imageLoad(directMap, s).rgb) * radianceUnit, 1.0));
 }

@@ -111,7 +111,7 @@ int runImportance(const ImportanceArgs& args) {
         const std::string stem = "importance_" + std::to_string(p);
         char scaleText[32];
         std::snprintf(scaleText, sizeof(scaleText), "%.9g", double(scale));
-        if (Status s = io::writeExrHalf(args.outDir + "/" + stem + ".exr", exr,
+        if (Status s = io::writeExr(args.outDir + "/" + stem + ".exr", exr,
                                         {{"bundlebake:quantity", "I(t), light map texels per scene unit^2 (supplement Eq. 4)"},
                                          {"bundlebake:importance_scale", scaleText}});
             !s)

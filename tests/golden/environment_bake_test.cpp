@@ -275,7 +275,7 @@ TEST(EnvironmentBake, CliEnvFileBakesAsInMemoryMap) {
     TempDir tmp("env");
     ASSERT_TRUE(tmp.ok());
     const io::ImageRgb env = lobeEnvironment();
-    const Status written = io::writeExrHalf(tmp / "env.exr", env);
+    const Status written = io::writeExr(tmp / "env.exr", env);
     ASSERT_TRUE(written) << written.message();
     CliResult cli = runCli({"bake", sourcePath("assets/open_box/open_box.gltf"), "-o", tmp / "out", "--backend",
                             backendName(defaultTestBackend()), "--uv-layout", "asset", "--resolution", "32",

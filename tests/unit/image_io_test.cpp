@@ -66,7 +66,7 @@ bool isOneLine(const std::string& s) { return !s.empty() && s.find('\n') == std:
 TEST_F(ImageIo, ExrRoundTripIsExactToHalf) {
     const ImageRgb image = gradient(13, 7);
     const std::string file = path("page0.exr");
-    ASSERT_TRUE(writeExrHalf(file, image).isOk());
+    ASSERT_TRUE(writeExr(file, image).isOk());
     Expected<ImageRgb> back = readImageRgb(file);
     ASSERT_TRUE(back) << back.error();
     ASSERT_EQ(back->width, 13);
@@ -85,7 +85,7 @@ TEST_F(ImageIo, ExrRoundTripIsExactToHalf) {
 
 TEST_F(ImageIo, ExrIsZipHalfRgbWithAttributes) {
     const std::string file = path("page1.exr");
-    ASSERT_TRUE(writeExrHalf(file, gradient(4, 4),
+    ASSERT_TRUE(writeExr(file, gradient(4, 4),
                              {{"bundlebake:units", "L_lm = E/pi"}, {"bundlebake:page", "1"}})
                     .isOk());
     auto in = OIIO::ImageInput::open(file);
@@ -101,8 +101,8 @@ TEST_F(ImageIo, ExrIsZipHalfRgbWithAttributes) {
 
 TEST_F(ImageIo, WriteReplacesAnExistingFileAtomically) {
     const std::string file = path("page.exr");
-    ASSERT_TRUE(writeExrHalf(file, gradient(2, 2)).isOk());
-    ASSERT_TRUE(writeExrHalf(file, gradient(5, 3)).isOk());
+    ASSERT_TRUE(writeExr(file, gradient(2, 2)).isOk());
+    ASSERT_TRUE(writeExr(file, gradient(5, 3)).isOk());
     Expected<ImageRgb> back = readImageRgb(file);
     ASSERT_TRUE(back) << back.error();
     EXPECT_EQ(back->width, 5);
@@ -111,7 +111,7 @@ TEST_F(ImageIo, WriteReplacesAnExistingFileAtomically) {
 
 TEST_F(ImageIo, WritingIntoAMissingDirectoryFailsWithOneLineNamingThePath) {
     const std::string exr = path("no/such/dir/page0.exr");
-    Status s = writeExrHalf(exr, gradient(2, 2));
+    Status s = writeExr(exr, gradient(2, 2));
     ASSERT_FALSE(s.isOk());
     EXPECT_TRUE(isOneLine(s.message())) << s.message();
     EXPECT_NE(s.message().find(exr), std::string::npos) << s.message();
@@ -135,7 +135,7 @@ TEST_F(ImageIo, WritingIntoAMissingDirectoryFailsWithOneLineNamingThePath) {
 TEST_F(ImageIo, FailedRenameLeavesNoTempFile) {
     // the target is a directory: the temp file is written, the rename fails
     fs::create_directories(path("taken.exr"));
-    Status s = writeExrHalf(path("taken.exr"), gradient(2, 2));
+    Status s = writeExr(path("taken.exr"), gradient(2, 2));
     ASSERT_FALSE(s.isOk());
     EXPECT_TRUE(isOneLine(s.message())) << s.message();
     EXPECT_NE(s.message().find(path("taken.exr")), std::string::npos);
@@ -278,3 +278,24 @@ TEST(ImageIoFlip, FlipRowsReversesRowOrder) {
 
 }  // namespace
 }  // namespace bb::io
+
+namespace bb {
+namespace {
+
+// Beyond half's range the EXR is written in 32-bit floats: 2e5 reads back 2e5, not Inf or 65504.
+TEST(ExrRange, ValuesBeyondTheHalfRangeAreKept) {
+    io::ImageRgb img;
+    img.width = 2;
+    img.height = 1;
+    img.pixels = {glm::vec3(2e5f, 1.0f, 0.5f), glm::vec3(0.25f)};
+    const std::string path = testing::TempDir() + "/bundlebake_exr_range_" + std::to_string(::getpid()) + ".exr";
+    ASSERT_TRUE(io::writeExr(path, img));
+    auto back = io::readImageRgb(path);
+    ASSERT_TRUE(back) << back.error();
+    EXPECT_EQ(back->pixels[0], img.pixels[0]);
+    EXPECT_EQ(back->pixels[1], img.pixels[1]);
+    std::remove(path.c_str());
+}
+
+}  // namespace
+}  // namespace bb
