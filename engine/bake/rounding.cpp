@@ -62,7 +62,7 @@ uint32_t encodeRgbe(glm::vec3 rgb, Rounding mode, glm::vec3 u) {
     for (int i = 0; i < 3; ++i)
         rgb[i] = rgb[i] >= std::numeric_limits<float>::min() ? std::min(rgb[i], std::numeric_limits<float>::max()) : 0.0f;
     const float maxc = std::max(rgb.r, std::max(rgb.g, rgb.b));
-    if (!(maxc >= 1e-38f)) return 0;
+    if (maxc == 0.0f) return 0;  // (not a denormal threshold: with DAZ set, as Embree sets it, that reads as 0)
     if (mode == Rounding::Nearest) u = glm::vec3(0.5f);
 
     int e = 0;
@@ -78,7 +78,7 @@ uint32_t encodeRgbe(glm::vec3 rgb, Rounding mode, glm::vec3 u) {
             for (uint32_t& qi : q) qi = std::min(qi, 255u);
         }
         if (std::max(q[0], std::max(q[1], q[2])) < 256u) {
-            // e >= -125 for maxc >= 1e-38, so the byte is >= 3: never the "zero" byte
+            // e >= -125 for maxc >= FLT_MIN, so the byte is >= 3: never the "zero" byte
             const uint32_t eb = uint32_t(std::clamp(es + 128, 0, 255));
             return q[0] | (q[1] << 8) | (q[2] << 16) | (eb << 24);
         }

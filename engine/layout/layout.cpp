@@ -218,6 +218,60 @@ double paddedArea(const RectSize& s, int padding) {
     return double(s.width + 2 * padding) * double(s.height + 2 * padding);
 }
 
+// Texel centres of the page inside more than one TEXCOORD_1 triangle (strictly:
+// a centre on a shared edge belongs to neither), and where the first one is.
+struct Overlap {
+    size_t texels = 0;
+    int x = 0, y = 0;
+    std::string first, second;  // instance names
+};
+
+Overlap findOverlaps(const Scene& scene, int res) {
+    std::vector<int32_t> owner(size_t(res) * res, -1);
+    std::vector<uint8_t> meshSeen(scene.meshes.size(), 0);
+    Overlap o;
+    for (size_t i = 0; i < scene.instances.size(); ++i) {
+        const Instance& inst = scene.instances[i];
+        if (meshSeen[size_t(inst.mesh)]++) continue;  // a mesh's other instances: warned about as such
+        for (const Primitive& prim : scene.meshes[size_t(inst.mesh)].primitives) {
+            if (prim.uv1.size() != prim.positions.size()) continue;
+            for (size_t t = 0; t + 2 < prim.indices.size(); t += 3) {
+                glm::dvec2 p[3];
+                for (int k = 0; k < 3; ++k) p[k] = glm::dvec2(prim.uv1[prim.indices[t + size_t(k)]]) * double(res);
+                const double area = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[2].x - p[0].x) * (p[1].y - p[0].y);
+                if (area == 0.0 || !std::isfinite(area)) continue;
+                const double sign = area > 0 ? 1.0 : -1.0;
+                const int x0 = std::max(0, int(std::floor(std::min({p[0].x, p[1].x, p[2].x}))));
+                const int x1 = std::min(res - 1, int(std::ceil(std::max({p[0].x, p[1].x, p[2].x}))));
+                const int y0 = std::max(0, int(std::floor(std::min({p[0].y, p[1].y, p[2].y}))));
+                const int y1 = std::min(res - 1, int(std::ceil(std::max({p[0].y, p[1].y, p[2].y}))));
+                for (int y = y0; y <= y1; ++y)
+                    for (int x = x0; x <= x1; ++x) {
+                        const glm::dvec2 c(x + 0.5, y + 0.5);
+                        bool inside = true;
+                        for (int k = 0; k < 3 && inside; ++k) {
+                            const glm::dvec2 a = p[k], b = p[(k + 1) % 3];
+                            inside = sign * ((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x)) > 0.0;
+                        }
+                        if (!inside) continue;
+                        int32_t& slot = owner[size_t(y) * res + x];
+                        if (slot >= 0) {
+                            if (o.texels++ == 0) {
+                                o.x = x;
+                                o.y = y;
+                                o.first = scene.instances[size_t(slot)].name;
+                                o.second = inst.name;
+                            }
+                        } else {
+                            slot = int32_t(i);
+                        }
+                    }
+            }
+        }
+    }
+    return o;
+}
+
 Layout assetLayout(const Scene& scene, const LayoutOptions& options) {
     Layout layout;
     layout.mode = UvLayout::Asset;
@@ -250,6 +304,19 @@ Layout assetLayout(const Scene& scene, const LayoutOptions& options) {
     return layout;
 }
 
+// Asset charts must not overlap: their texels would hold two surfaces.
+Status checkOverlaps(const Scene& scene, const LayoutOptions& options, Layout& layout) {
+    const Overlap o = findOverlaps(scene, options.resolution);
+    layout.overlappingTexels = o.texels;
+    if (o.texels == 0) return Status::ok();
+    const std::string what = std::to_string(o.texels) + " light map texel(s) lie in two TEXCOORD_1 triangles at once, e.g. texel (" +
+                             std::to_string(o.x) + ", " + std::to_string(o.y) + ") of " + o.first + " and " + o.second;
+    if (options.failOnOverlap) return Status::error(what + " (overlapping charts; --uv-overlap fail)");
+    logWarning(what + ": those texels mix two surfaces. Fix the charts, or use --uv-layout pack if they are instances "
+               "of one mesh, or --uv-overlap fail to refuse such scenes");
+    return Status::ok();
+}
+
 }  // namespace
 
 Expected<Layout> computeLayout(const Scene& scene, const LayoutOptions& options) {
@@ -261,7 +328,9 @@ Expected<Layout> computeLayout(const Scene& scene, const LayoutOptions& options)
                                          "in the exporting tool");
             !s)
             return s;
-        return assetLayout(scene, options);
+        Layout layout = assetLayout(scene, options);
+        if (Status s = checkOverlaps(scene, options, layout); !s) return s;
+        return layout;
     }
 
     if (Status s = requireUv1(scene, "light map UV generation is not implemented yet; add a second UV set "

@@ -27,6 +27,10 @@ struct LayoutOptions {
     int resolution = 512;        // page width = height in texels (typ. 256..4096)
     float texelDensity = 0.0f;   // texels per scene unit; 0 = auto: fit the scene into about one page
     int padding = 2;             // free texels around every rectangle (pack), for dilation and bilinear filtering
+    // asset: texel centres inside two TEXCOORD_1 triangles (overlapping charts,
+    // which would share texels and race in the update pass) are counted and
+    // reported with an example; true makes that an error.
+    bool failOnOverlap = false;
 };
 
 struct InstanceRect {
@@ -45,11 +49,13 @@ struct Layout {
     int padding = 0;
     float texelDensity = 0.0f;          // global density used (pack), texels per scene unit
     std::vector<InstanceRect> rects;    // one per Scene::instances entry
+    size_t overlappingTexels = 0;       // asset: texel centres inside more than one triangle
     size_t texelCount() const { return size_t(pageCount) * resolution * resolution; }
 };
 
 // Errors: resolution out of [16, 16384], negative density, padding < 0,
-// asset mode on a scene without TEXCOORD_1 everywhere (one line with a hint).
+// asset mode on a scene without TEXCOORD_1 everywhere (one line with a hint),
+// overlapping asset charts with failOnOverlap.
 Expected<Layout> computeLayout(const Scene& scene, const LayoutOptions& options);
 
 }  // namespace bb

@@ -39,7 +39,7 @@ uint encodeRgbe(vec3 c, vec3 u) {
     // negatives, NaN and denormals -> 0; +Inf -> the largest float, which saturates below
     for (int i = 0; i < 3; ++i) c[i] = c[i] >= 1.17549435e-38 ? min(c[i], 3.40282347e38) : 0.0;
     float m = max(c.r, max(c.g, c.b));
-    if (!(m >= 1e-38)) return 0u;
+    if (m == 0.0) return 0u;
 #ifdef ROUNDING_NEAREST
     u = vec3(0.5);
 #endif

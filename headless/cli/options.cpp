@@ -18,6 +18,10 @@ void addSceneOptions(CLI::App& cmd, SceneArgs& a) {
     cmd.add_option("--uv-layout", a.uvLayout, "Light map layout: pack (a rectangle per instance) or asset (TEXCOORD_1 as one atlas)")
         ->check(CLI::IsMember({"pack", "asset"}))
         ->capture_default_str();
+    cmd.add_option("--uv-overlap", a.uvOverlap,
+                   "Overlapping TEXCOORD_1 charts under --uv-layout asset: warn (count and where) or fail")
+        ->check(CLI::IsMember({"warn", "fail"}))
+        ->capture_default_str();
     cmd.add_option("--resolution", a.resolution, "Light map page size in texels (square)")
         ->check(CLI::Range(16, 16384))
         ->capture_default_str();
@@ -90,6 +94,7 @@ Expected<LoadedScene> loadSceneAndLayout(const SceneArgs& a) {
     if (!scene) return scene.status();
     LayoutOptions opts;
     opts.mode = a.uvLayout == "asset" ? UvLayout::Asset : UvLayout::Pack;
+    opts.failOnOverlap = a.uvOverlap == "fail";
     opts.resolution = a.resolution;
     opts.texelDensity = a.texelDensity;
     auto layout = computeLayout(*scene, opts);

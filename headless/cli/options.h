@@ -20,6 +20,7 @@ namespace bb::cli {
 struct SceneArgs {
     std::string scene;
     std::string uvLayout = "pack";
+    std::string uvOverlap = "warn";
     int resolution = 512;
     float texelDensity = 0.0f;
     std::string defaultAlbedo = "0.8,0.8,0.8";

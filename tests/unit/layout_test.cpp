@@ -469,8 +469,9 @@ TEST(LayoutAsset, OnePageIdentityMapping) {
 
 TEST(LayoutAsset, WarnsWhenAMeshIsInstancedMoreThanOnce) {
     Scene scene = emptyScene();
-    const int shared = addMesh(scene, quadMesh("shared", 1.0f, 1.0f));
-    const int single = addMesh(scene, quadMesh("single", 1.0f, 1.0f));
+    // two charts side by side in the atlas: no overlap until 'shared' is instanced twice
+    const int shared = addMesh(scene, quadMesh("shared", 1.0f, 1.0f, glm::vec2(0.5f, 0.0f), glm::vec2(1.0f, 1.0f)));
+    const int single = addMesh(scene, quadMesh("single", 1.0f, 1.0f, glm::vec2(0.0f), glm::vec2(0.5f, 1.0f)));
     addInstance(scene, single);
     addInstance(scene, shared);
     LayoutOptions options;
@@ -699,6 +700,43 @@ TEST(BakeMesh, MissingNormalsFallBackToTheFaceNormal) {
     // normal taken from the re-ordered winding
     ASSERT_EQ(mesh.vertices.size(), size_t(6));
     for (const BakeVertex& v : mesh.vertices) EXPECT_EQ(v.normal, glm::vec4(0.0f, 0.0f, -1.0f, 0.0f));
+}
+
+}  // namespace
+}  // namespace bb
+
+namespace bb {
+namespace {
+
+// Asset charts: texel centres in two TEXCOORD_1 triangles are counted and
+// reported (issue 13); --uv-overlap fail refuses the scene.
+TEST(LayoutAsset, OverlappingChartsAreCountedAndCanBeRefused) {
+    // two quads whose uv squares overlap in [0.25, 0.5]^2 of a 16-texel page:
+    // 4 x 4 texel centres, less the 4 on both quads' diagonal (x = y: a centre
+    // on an edge belongs to neither triangle)
+    Scene scene = emptyScene();
+    Mesh m = proportionalQuad("a", 1.0f, 1.0f);
+    for (glm::vec2& uv : m.primitives[0].uv1) uv *= 0.5f;                          // [0, 0.5]^2
+    Mesh n = proportionalQuad("b", 1.0f, 1.0f);
+    for (glm::vec2& uv : n.primitives[0].uv1) uv = uv * 0.5f + glm::vec2(0.25f);  // [0.25, 0.75]^2
+    addInstance(scene, addMesh(scene, m));
+    addInstance(scene, addMesh(scene, n), translate(5, 0, 0));
+    LayoutOptions o;
+    o.mode = UvLayout::Asset;
+    o.resolution = 16;
+    auto layout = computeLayout(scene, o);
+    ASSERT_TRUE(layout) << layout.error();
+    EXPECT_EQ(layout->overlappingTexels, 12u);
+    o.failOnOverlap = true;
+    auto refused = computeLayout(scene, o);
+    ASSERT_FALSE(refused);
+    EXPECT_NE(refused.error().find("12 light map texel(s)"), std::string::npos) << refused.error();
+    EXPECT_NE(refused.error().find("node 0 and node 1"), std::string::npos) << refused.error();
+    // apart, they do not overlap (the shared diagonal of each quad counts once)
+    for (glm::vec2& uv : scene.meshes[1].primitives[0].uv1) uv += glm::vec2(0.25f);  // [0.5, 1]^2
+    auto apart = computeLayout(scene, o);
+    ASSERT_TRUE(apart) << apart.error();
+    EXPECT_EQ(apart->overlappingTexels, 0u);
 }
 
 }  // namespace
