@@ -96,6 +96,12 @@ BakeMesh buildBakeMesh(const Scene& scene, const Layout& layout) {
                     if (v[k].normal == glm::vec4(0.0f) && faceLen > 0.0f)
                         v[k].normal = glm::vec4(face / faceLen, 0.0f);
                 }
+                // the triangle's side as the update pass derives it (TRIANGLE_DERIVATIVE_NORMAL_FLIPPED)
+                const glm::vec3 shading = glm::vec3(v[0].normal + v[1].normal + v[2].normal);
+                const glm::vec2 e1 = v[1].lightmapUv - v[0].lightmapUv, e2 = v[2].lightmapUv - v[0].lightmapUv;
+                const bool windingAgrees = glm::dot(face, shading) >= 0.0f;
+                const bool uvCounterClockwise = double(e1.x) * e2.y - double(e1.y) * e2.x > 0.0;
+                if (windingAgrees != uvCounterClockwise) out.triangles[slot].flags |= TRIANGLE_DERIVATIVE_NORMAL_FLIPPED;
             }
         }
     }

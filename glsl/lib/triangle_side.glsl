@@ -5,8 +5,9 @@ layout(std430, binding = BINDING_VERTICES) readonly buffer Vertices { BakeVertex
 
 // Mesh triangle t's plane normal (not normalised), oriented as its shading
 // normals are on the whole: the side the bundle pass gives its fragments and
-// the update pass its texels. A vertex normal alone can point the other way
-// near a smooth mesh's silhouette.
+// the update pass its texels (there from TRIANGLE_DERIVATIVE_NORMAL_FLIPPED,
+// computed the same way with the mesh). A vertex normal alone can point the
+// other way near a smooth mesh's silhouette.
 vec3 triangleSide(uint t) {
     uint v0 = 3u * (t - meshChunkFirstTriangle);
     vec3 w0 = vertices[v0].position.xyz, w1 = vertices[v0 + 1u].position.xyz, w2 = vertices[v0 + 2u].position.xyz;

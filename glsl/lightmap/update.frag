@@ -19,6 +19,7 @@
 // light's float sums (lib/direct_scratch.glsl) and 1 to its sample count (the
 // direct map's alpha; direct_fold.comp divides): an exact shadow test, no noise.
 #include "shared/bundle_layout.h"
+#include "shared/mesh_layout.h"
 #include "lib/rounding.glsl"
 #include "lib/bundle_frame.glsl"
 
@@ -26,7 +27,6 @@ in vec3 vPosition;
 in vec3 vNormal;
 flat in uint vFlags;
 flat in uint vPage;
-flat in vec3 vSide;
 
 layout(binding = BINDING_HEADS, r32ui) uniform readonly uimage2D heads;
 layout(std430, binding = BINDING_NODES) readonly buffer Nodes { Node nodes[]; };
@@ -72,8 +72,12 @@ void main() {
     if (gl_HelperInvocation) return;
     vec3 n = normalize(vNormal);
     // the triangle's plane, on the side the bundle pass gives its fragments
-    vec3 ng = length(faceNormal) > 0.0 ? normalize(faceNormal) : n;
-    if (dot(ng, vSide) < 0.0) ng = -ng;
+    // (lib/triangle_side.glsl; the flag is computed with the mesh)
+    vec3 ng = n;
+    if (length(faceNormal) > 0.0) {
+        ng = normalize(faceNormal);
+        if ((vFlags & TRIANGLE_DERIVATIVE_NORMAL_FLIPPED) != 0u) ng = -ng;
+    }
     vec3 b = bundleFromWorld(vPosition);
     vec2 q = rootFromBundle(b.xy);
     if (!leafOwns(q)) return;  // another leaf's

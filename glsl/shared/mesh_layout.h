@@ -4,6 +4,11 @@
 #define BUNDLEBAKE_MESH_LAYOUT_H
 #define TRIANGLE_DOUBLE_SIDED 1u
 #define TRIANGLE_EMISSIVE 2u
+// The triangle's side (lib/triangle_side.glsl) is the opposite of the normal
+// the update pass takes from screen derivatives in light map space,
+// cross(dFdx(P), dFdy(P)) = (p1 - p0) x (p2 - p0) / uv determinant: set where
+// the winding disagrees with the shading normals XOR the uv triangle is clockwise.
+#define TRIANGLE_DERIVATIVE_NORMAL_FLIPPED 4u
 
 // SSBO binding of BakeTriangle triangles[] (lib/bake_vertex.glsl), bound in
 // chunks by MeshChunks (engine/layout/bake_mesh_gl.h)
