@@ -40,27 +40,10 @@
 namespace bb::test {
 namespace {
 
+// makeBake (an absolute path works too), baked to the end.
 SceneBake bakeFile(const std::string& path, const LayoutOptions& layoutOptions, const BakeOptions& bakeOptions) {
-    SceneBake out;
-    auto scene = loadScene(path);
-    if (!scene) {
-        out.error = "loadScene: " + scene.error();
-        return out;
-    }
-    out.scene = std::move(scene.value());
-    auto layout = computeLayout(out.scene, layoutOptions);
-    if (!layout) {
-        out.error = "computeLayout: " + layout.error();
-        return out;
-    }
-    out.layout = std::move(layout.value());
-    auto baker = Baker::create(out.scene, out.layout, bakeOptions);
-    if (!baker) {
-        out.error = "Baker::create: " + baker.error();
-        return out;
-    }
-    out.baker = std::move(baker.value());
-    bakeToEnd(*out.baker);
+    SceneBake out = makeBake(path, layoutOptions, bakeOptions);
+    if (out) bakeToEnd(*out.baker);
     return out;
 }
 

@@ -31,17 +31,6 @@ struct ChunkLimit {
     ~ChunkLimit() { setMeshChunkBytesForTesting(0); }
 };
 
-std::string generateCity(const std::string& name, const std::string& flags) {
-    const std::string dir = ::testing::TempDir() + "/mesh_chunks_" + std::to_string(::getpid());
-    std::filesystem::create_directories(dir);
-    const std::string path = dir + "/" + name + ".gltf";
-    const std::string cmd = "python3 " + sourcePath("scripts/generate_city.py") + " --preset tiny " + flags + " -o " +
-                            path + " > /dev/null";
-    const int status = std::system(cmd.c_str());
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) return "";
-    return path;
-}
-
 LayoutOptions cityLayout() {
     LayoutOptions l;
     l.mode = UvLayout::Pack;
@@ -145,7 +134,7 @@ TEST(MeshChunks, SmallLimitGivesAlignedChunks) {
 // update pass read the mesh's SSBOs chunk by chunk, and no bit moves.
 TEST(MeshChunksBake, SmallChunksGiveTheSameBits) {
     BB_REQUIRE_GL();
-    const std::string city = generateCity("bake", "--seed 5");
+    const std::string city = generateTinyCity("bake", "--seed 5");
     ASSERT_FALSE(city.empty()) << "scripts/generate_city.py failed";
     const Baked whole = bakeCity(city, 0);
     ASSERT_TRUE(whole.error.empty()) << whole.error;
@@ -168,7 +157,7 @@ TEST(MeshChunksBake, SmallChunksGiveTheSameBits) {
 // pass (4 bytes per triangle) and fewer in the clamp pass: the same bits.
 TEST(MeshChunksBake, ImportanceSameBits) {
     BB_REQUIRE_GL();
-    const std::string city = generateCity("importance", "--seed 7");
+    const std::string city = generateTinyCity("importance", "--seed 7");
     ASSERT_FALSE(city.empty()) << "scripts/generate_city.py failed";
     auto scene = loadScene(city);
     ASSERT_TRUE(scene) << scene.error();
@@ -199,7 +188,7 @@ TEST(MeshChunksBake, ImportanceSameBits) {
 // read per chunk; lit and importance views byte for byte.
 TEST(MeshChunksBake, RendererSameBytes) {
     BB_REQUIRE_GL();
-    const std::string city = generateCity("render", "--seed 8");
+    const std::string city = generateTinyCity("render", "--seed 8");
     ASSERT_FALSE(city.empty()) << "scripts/generate_city.py failed";
     const Baked baked = bakeCity(city, 0);
     ASSERT_TRUE(baked.error.empty()) << baked.error;

@@ -17,18 +17,6 @@
 namespace bb::test {
 namespace {
 
-// Generates a tiny city (seeded) into the test's temp dir; returns its path relative to nothing (absolute).
-std::string generateCity(const std::string& name, const std::string& flags) {
-    const std::string dir = ::testing::TempDir() + "/tiling_" + std::to_string(::getpid());
-    std::filesystem::create_directories(dir);
-    const std::string path = dir + "/" + name + ".gltf";
-    const std::string cmd = "python3 " + sourcePath("scripts/generate_city.py") + " --preset tiny " + flags + " -o " +
-                            path + " > /dev/null";
-    const int status = std::system(cmd.c_str());
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) return "";
-    return path;
-}
-
 LayoutOptions cityLayout() {
     LayoutOptions l;
     l.mode = UvLayout::Pack;
@@ -77,7 +65,7 @@ size_t differingTexels(const Baked& a, const Baked& b) {
 // number, so the accumulators are the same bits.
 TEST(TilingBake, TinyBudgetGivesTheSameBits) {
     BB_REQUIRE_GL();
-    const std::string city = generateCity("budget", "--seed 5");
+    const std::string city = generateTinyCity("budget", "--seed 5");
     ASSERT_FALSE(city.empty()) << "scripts/generate_city.py failed";
     const Baked roomy = bakeCity(city, cityOptions());
     ASSERT_TRUE(roomy.error.empty()) << roomy.error;
@@ -109,7 +97,7 @@ TEST(TilingBake, TinyBudgetGivesTheSameBits) {
 // Culling draws a fraction of the clusters per tile and changes no bit.
 TEST(TilingBake, CullingChangesNothing) {
     BB_REQUIRE_GL();
-    const std::string city = generateCity("culling", "--seed 6");
+    const std::string city = generateTinyCity("culling", "--seed 6");
     ASSERT_FALSE(city.empty()) << "scripts/generate_city.py failed";
     BakeOptions o = cityOptions();
     o.bundleMemory = 1 << 20;  // several tiles per direction, so there is something to cull
@@ -132,7 +120,7 @@ TEST(TilingBake, CullingChangesNothing) {
 // the same tiles in the same order, so the same bits as whole directions.
 TEST(TilingBake, SteppingByTileGivesTheSameBits) {
     BB_REQUIRE_GL();
-    const std::string city = generateCity("steps", "--seed 4");
+    const std::string city = generateTinyCity("steps", "--seed 4");
     ASSERT_FALSE(city.empty()) << "scripts/generate_city.py failed";
     BakeOptions o = cityOptions();
     o.bundleMemory = 1 << 20;
@@ -169,7 +157,7 @@ TEST(TilingBake, PredictionHoldsOnThreeSizes) {
                  {"s2", "--seed 8"},
                  {"s3", "--seed 9 --size-m 320 --buildings 300 --terrain-quads 12"}};
     for (const Size& s : sizes) {
-        const std::string city = generateCity(s.name, s.flags);
+        const std::string city = generateTinyCity(s.name, s.flags);
         ASSERT_FALSE(city.empty()) << "scripts/generate_city.py failed for " << s.flags;
         BakeOptions o = cityOptions();
         o.bundleMemory = 1 << 20;

@@ -7,11 +7,16 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <cstdio>
 #include <limits>
 #include <memory>
 #include <string>
 #include <vector>
+
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <glm/glm.hpp>
 
@@ -55,6 +60,19 @@ inline SceneBake makeBake(const std::string& assetRelative, const LayoutOptions&
     }
     out.baker = std::move(baker.value());
     return out;
+}
+
+// Generates a tiny city (scripts/generate_city.py, seeded by `flags`) into a
+// per-process temp dir; returns its absolute path, or "" if the script failed.
+inline std::string generateTinyCity(const std::string& name, const std::string& flags) {
+    const std::string dir = ::testing::TempDir() + "/cities_" + std::to_string(::getpid());
+    std::filesystem::create_directories(dir);
+    const std::string path = dir + "/" + name + ".gltf";
+    const std::string cmd = "python3 " + sourcePath("scripts/generate_city.py") + " --preset tiny " + flags + " -o " +
+                            path + " > /dev/null";
+    const int status = std::system(cmd.c_str());
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) return "";
+    return path;
 }
 
 inline LayoutOptions assetLayout(int resolution) {
