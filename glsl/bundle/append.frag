@@ -1,7 +1,7 @@
 #version 430
 // Bundle pass: append one node per fragment to its pixel's linked list.
 // Outgoing radiance comes from the previous iteration: Lo = Le + albedo * L_lm,
-// resolved per texel into `radiance` (lightmap/resolve.comp).
+// written per texel into the RGB9E5 `radiance` (lightmap/meta.frag).
 #include "shared/bundle_layout.h"
 #include "shared/mesh_layout.h"
 #include "lib/rounding.glsl"

@@ -1,7 +1,7 @@
 #version 430
-// Meta pass (Unity's name for it): surface albedo and emission rasterized
-// once into light map space, so the bundle pass reads Lo = Le + albedo * L_lm
-// per texel from one texture.
+// Meta pass (Unity's name for it): the surface rasterized into light map
+// space, for the coverage (once) and the outgoing radiance Lo = Le + albedo *
+// L_lm the bundle pass reads (each refresh; meta.frag).
 #include "lib/bake_vertex.glsl"
 
 out vec2 vUv0;
