@@ -174,11 +174,11 @@ Status Baker::loadCheckpoint(const std::string& path) {
                               std::fread(counters.data(), 1, counters.size(), f) == counters.size();
     std::fclose(f);
     if (!ok || !countersRead) return Status::error("cannot read checkpoint " + path);
+    if (h.key != checkpointKey(m))
+        return Status::error(path + " was written for another scene or other bake options; remove it or bake without --resume");
     BakeStats restored = m.stats;
     if (!restoreStatsCounters(nlohmann::json::parse(counters, nullptr, false), restored))
         return Status::error(path + ": corrupt statistics (remove it or bake without --resume)");
-    if (h.key != checkpointKey(m))
-        return Status::error(path + " was written for another scene or other bake options; remove it or bake without --resume");
     if (h.directionsDone < 0 || h.directionsDone > m.options.directions)
         return Status::error(path + ": corrupt progress count");
     gl::writeTexture(m.accum.id(), 0, 0, 0, res, res, m.layout.pageCount, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
