@@ -194,15 +194,19 @@ void Baker::Impl::drawSurface(GLuint program, bool materialUniforms) {
     glBindFramebuffer(GL_FRAMEBUFFER, pageFbo.id());
     glViewport(0, 0, layout.resolution, layout.resolution);
     const GLint pageUniform = glGetUniformLocation(program, "page");
+    const GLint albedoUniform = glGetUniformLocation(program, "albedo");
+    const GLint emissionUniform = glGetUniformLocation(program, "emission");
+    const GLint hasAlbedoUniform = glGetUniformLocation(program, "hasAlbedoTexture");
+    const GLint hasEmissionUniform = glGetUniformLocation(program, "hasEmissionTexture");
     for (const SurfaceRun& run : surfaceRuns) {
         glUniform1i(pageUniform, GLint(run.page));
         if (materialUniforms) {
             const Material& mat = materials[run.material];
-            glUniform3fv(glGetUniformLocation(program, "albedo"), 1, &mat.albedo.x);
+            glUniform3fv(albedoUniform, 1, &mat.albedo.x);
             const glm::vec3 emission = mat.emission / radianceUnit;
-            glUniform3fv(glGetUniformLocation(program, "emission"), 1, &emission.x);
-            glUniform1i(glGetUniformLocation(program, "hasAlbedoTexture"), mat.albedoTexture >= 0);
-            glUniform1i(glGetUniformLocation(program, "hasEmissionTexture"), mat.emissionTexture >= 0);
+            glUniform3fv(emissionUniform, 1, &emission.x);
+            glUniform1i(hasAlbedoUniform, mat.albedoTexture >= 0);
+            glUniform1i(hasEmissionUniform, mat.emissionTexture >= 0);
             if (mat.albedoTexture >= 0) glBindTextureUnit(BINDING_MATERIAL_TEX, materialTextures[mat.albedoTexture].id());
             if (mat.emissionTexture >= 0)
                 glBindTextureUnit(BINDING_MATERIAL_TEX + 1, materialTextures[mat.emissionTexture].id());

@@ -31,20 +31,8 @@ struct ChunkLimit {
     ~ChunkLimit() { setMeshChunkBytesForTesting(0); }
 };
 
-LayoutOptions cityLayout() {
-    LayoutOptions l;
-    l.mode = UvLayout::Pack;
-    l.resolution = 512;
-    return l;
-}
-
-BakeOptions cityOptions() {
-    BakeOptions o;
-    o.directions = 6;
-    o.seed = 11;
-    o.sky = glm::vec3(1.0f);
-    return o;
-}
+LayoutOptions cityLayout() { return packLayout(512); }
+BakeOptions cityOptions() { return skyOptions(6, 11); }
 
 struct Baked {
     std::vector<std::vector<glm::vec4>> accumulators;

@@ -34,9 +34,7 @@ namespace {
 void checkSealedRoomStaysDark(int bundleResolution, int directions,
                               BakeOptions::Tiling tiling = BakeOptions::Tiling::Adaptive) {
     BB_REQUIRE_GL();
-    LayoutOptions layout;
-    layout.mode = UvLayout::Pack;
-    layout.resolution = 720;
+    LayoutOptions layout = packLayout(720);
     layout.texelDensity = 50.0f;  // 2 cm texels: the slab is one texel thick
     BakeOptions options;
     options.directions = directions;

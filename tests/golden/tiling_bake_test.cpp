@@ -17,20 +17,8 @@
 namespace bb::test {
 namespace {
 
-LayoutOptions cityLayout() {
-    LayoutOptions l;
-    l.mode = UvLayout::Pack;
-    l.resolution = 512;
-    return l;
-}
-
-BakeOptions cityOptions() {
-    BakeOptions o;
-    o.directions = 8;
-    o.seed = 3;
-    o.sky = glm::vec3(1.0f);
-    return o;
-}
+LayoutOptions cityLayout() { return packLayout(512); }
+BakeOptions cityOptions() { return skyOptions(8, 3); }
 
 struct Baked {
     std::vector<std::vector<glm::vec4>> accumulators;

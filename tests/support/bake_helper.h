@@ -75,6 +75,22 @@ inline std::string generateTinyCity(const std::string& name, const std::string& 
     return path;
 }
 
+inline LayoutOptions packLayout(int resolution) {
+    LayoutOptions o;
+    o.mode = UvLayout::Pack;
+    o.resolution = resolution;
+    return o;
+}
+
+// Bake options under a uniform white sky.
+inline BakeOptions skyOptions(int directions, uint64_t seed) {
+    BakeOptions o;
+    o.directions = directions;
+    o.seed = seed;
+    o.sky = glm::vec3(1.0f);
+    return o;
+}
+
 inline LayoutOptions assetLayout(int resolution) {
     LayoutOptions o;
     o.mode = UvLayout::Asset;
