@@ -1,5 +1,7 @@
 // Light map layout: asset (one shared atlas) or pack (one rectangle per
-// instance, sized by world area x texel density, shelf-packed into pages).
+// instance, sized by world area x texel density, shelf-packed into pages),
+// with TEXCOORD_1 generated (uv_generate.h) where a mesh has none or with
+// --uv-layout generate.
 //
 // Based on: DESIGN.md "Data flow" step 2. Shelf packing with heights sorted
 // in decreasing order is the classic "next-fit decreasing height" (NFDH)
@@ -7,10 +9,14 @@
 #include "layout/layout.h"
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <numeric>
 #include <string>
+#include <thread>
+#include <utility>
 
 #include "core/check.h"
 #include "core/log.h"
@@ -30,6 +36,7 @@ struct InstanceUv {
     glm::dvec2 uvMax{0.0};
     double uvArea = 0.0;      // sum of |triangle areas| in TEXCOORD_1 space
     double worldArea = 0.0;   // sum of triangle areas after worldFromObject
+    glm::ivec2 grid{0};       // generated TEXCOORD_1: the rectangle is exactly this grid (uv1 spans [0,1]^2)
     bool empty() const { return !(uvArea > 0.0) || !(worldArea > 0.0); }
     glm::dvec2 uvSize() const { return uvMax - uvMin; }
 };
@@ -100,11 +107,21 @@ Status requireUv1(const Scene& scene, const char* why) {
     return Status::ok();
 }
 
-InstanceUv measureInstance(const Scene& scene, size_t instance) {
+// `generated`: TEXCOORD_1 is (or is about to be) generated on a grid: only
+// the world area is measured, the UV box is [0,1]^2.
+InstanceUv measureInstance(const Scene& scene, size_t instance, bool generated) {
     const Instance& inst = scene.instances[instance];
     const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
     const glm::dmat4 worldFromObject(inst.worldFromObject);
     InstanceUv m;
+    if (generated) {
+        m.worldArea = scene.instanceArea(instance);
+        m.uvMin = glm::dvec2(0.0);
+        m.uvMax = glm::dvec2(1.0);
+        m.uvArea = 1.0;
+        m.grid = mesh.uv1Grid;
+        return m;
+    }
     m.uvMin = glm::dvec2(1e300);
     m.uvMax = glm::dvec2(-1e300);
     bool any = false;
@@ -218,26 +235,29 @@ double paddedArea(const RectSize& s, int padding) {
     return double(s.width + 2 * padding) * double(s.height + 2 * padding);
 }
 
-// Texel centres of the page inside more than one TEXCOORD_1 triangle (strictly:
-// a centre on a shared edge belongs to neither), and where the first one is.
-struct Overlap {
-    size_t texels = 0;
-    int x = 0, y = 0;
-    std::string first, second;  // instance names
-};
-
-Overlap findOverlaps(const Scene& scene, int res) {
-    std::vector<int32_t> owner(size_t(res) * res, -1);
+// Texel centres of the pages inside the instances' TEXCOORD_1 triangles
+// through their rectangles (strictly: a centre on a shared edge belongs to
+// neither side), counting those inside two. Asset layouts visit each mesh
+// once (a mesh's other instances are warned about as such).
+TexelCoverage coverage(const Scene& scene, const Layout& layout) {
+    const int res = layout.resolution;
+    std::vector<std::vector<int32_t>> owner(size_t(std::max(layout.pageCount, 0)));
     std::vector<uint8_t> meshSeen(scene.meshes.size(), 0);
-    Overlap o;
-    for (size_t i = 0; i < scene.instances.size(); ++i) {
+    TexelCoverage o;
+    for (size_t i = 0; i < scene.instances.size() && i < layout.rects.size(); ++i) {
         const Instance& inst = scene.instances[i];
-        if (meshSeen[size_t(inst.mesh)]++) continue;  // a mesh's other instances: warned about as such
+        if (layout.mode == UvLayout::Asset && meshSeen[size_t(inst.mesh)]++) continue;
+        const InstanceRect& r = layout.rects[i];
+        if (r.page < 0 || r.page >= layout.pageCount) continue;
+        std::vector<int32_t>& page = owner[size_t(r.page)];
+        if (page.empty()) page.assign(size_t(res) * size_t(res), -1);
+        const glm::dvec2 scale(r.scale), offset(r.offset);
         for (const Primitive& prim : scene.meshes[size_t(inst.mesh)].primitives) {
             if (prim.uv1.size() != prim.positions.size()) continue;
             for (size_t t = 0; t + 2 < prim.indices.size(); t += 3) {
                 glm::dvec2 p[3];
-                for (int k = 0; k < 3; ++k) p[k] = glm::dvec2(prim.uv1[prim.indices[t + size_t(k)]]) * double(res);
+                for (int k = 0; k < 3; ++k)
+                    p[k] = (glm::dvec2(prim.uv1[prim.indices[t + size_t(k)]]) * scale + offset) * double(res);
                 const double area = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[2].x - p[0].x) * (p[1].y - p[0].y);
                 if (area == 0.0 || !std::isfinite(area)) continue;
                 const double sign = area > 0 ? 1.0 : -1.0;
@@ -254,9 +274,10 @@ Overlap findOverlaps(const Scene& scene, int res) {
                             inside = sign * ((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x)) > 0.0;
                         }
                         if (!inside) continue;
-                        int32_t& slot = owner[size_t(y) * res + x];
+                        int32_t& slot = page[size_t(y) * size_t(res) + size_t(x)];
                         if (slot >= 0) {
-                            if (o.texels++ == 0) {
+                            if (o.overlapping++ == 0) {
+                                o.page = r.page;
                                 o.x = x;
                                 o.y = y;
                                 o.first = scene.instances[size_t(slot)].name;
@@ -264,6 +285,7 @@ Overlap findOverlaps(const Scene& scene, int res) {
                             }
                         } else {
                             slot = int32_t(i);
+                            ++o.covered;
                         }
                     }
             }
@@ -305,11 +327,12 @@ Layout assetLayout(const Scene& scene, const LayoutOptions& options) {
 }
 
 // Asset charts must not overlap: their texels would hold two surfaces.
+// Asset charts must not overlap: their texels would hold two surfaces.
 Status checkOverlaps(const Scene& scene, const LayoutOptions& options, Layout& layout) {
-    const Overlap o = findOverlaps(scene, options.resolution);
-    layout.overlappingTexels = o.texels;
-    if (o.texels == 0) return Status::ok();
-    const std::string what = std::to_string(o.texels) + " light map texel(s) lie in two TEXCOORD_1 triangles at once, e.g. texel (" +
+    const TexelCoverage o = coverage(scene, layout);
+    layout.overlappingTexels = o.overlapping;
+    if (o.overlapping == 0) return Status::ok();
+    const std::string what = std::to_string(o.overlapping) + " light map texel(s) lie in two TEXCOORD_1 triangles at once, e.g. texel (" +
                              std::to_string(o.x) + ", " + std::to_string(o.y) + ") of " + o.first + " and " + o.second;
     if (options.failOnOverlap) return Status::error(what + " (overlapping charts; --uv-overlap fail)");
     logWarning(what + ": those texels mix two surfaces. Fix the charts, or use --uv-layout pack if they are instances "
@@ -317,33 +340,44 @@ Status checkOverlaps(const Scene& scene, const LayoutOptions& options, Layout& l
     return Status::ok();
 }
 
-}  // namespace
+// Meshes whose TEXCOORD_1 is generated by this computeLayout call: their
+// charts, and the packing of the last sizing (the final one once the density
+// is chosen).
+struct GeneratedMeshes {
+    std::vector<const MeshCharts*> charts;  // per scene mesh; null if not generated now
+    std::vector<ChartPacking> packing;      // per scene mesh
+};
 
-Expected<Layout> computeLayout(const Scene& scene, const LayoutOptions& options) {
-    if (Status s = validate(scene, options); !s) return s;
+// The pack layout (pack and generate modes). `gen` (may be null): meshes
+// sized by packing their charts at the layout's density.
+Expected<Layout> packLayout(const Scene& scene, const LayoutOptions& options, GeneratedMeshes* gen) {
     const int res = options.resolution, pad = options.padding;
+    const int maxSide = res - 2 * pad;
+    auto generatedNow = [&](int mesh) { return gen != nullptr && gen->charts[size_t(mesh)] != nullptr; };
 
-    if (options.mode == UvLayout::Asset) {
-        if (Status s = requireUv1(scene, "--uv-layout asset uses TEXCOORD_1 as the atlas; add a second UV set "
-                                         "in the exporting tool");
-            !s)
-            return s;
-        Layout layout = assetLayout(scene, options);
-        if (Status s = checkOverlaps(scene, options, layout); !s) return s;
-        return layout;
+    // every instance without generated TEXCOORD_1 must carry it
+    for (size_t i = 0; i < scene.instances.size(); ++i) {
+        const int mi = scene.instances[i].mesh;
+        if (generatedNow(mi)) continue;
+        const Mesh& mesh = scene.meshes[size_t(mi)];
+        for (size_t p = 0; p < mesh.primitives.size(); ++p) {
+            const Primitive& prim = mesh.primitives[p];
+            if (prim.triangleCount() == 0 || prim.uv1.size() == prim.positions.size()) continue;
+            return Status::error("mesh " + meshName(scene, mi) + " (primitive " + std::to_string(p) + ", instance " +
+                                 instanceName(scene, i) +
+                                 ") has no TEXCOORD_1 light map UVs; computeLayout(const Scene&) does not generate "
+                                 "them (computeLayout(Scene&) does)");
+        }
     }
-
-    if (Status s = requireUv1(scene, "light map UV generation is not implemented yet; add a second UV set "
-                                     "(TEXCOORD_1) in the exporting tool");
-        !s)
-        return s;
 
     // measure: UV bounding box, UV area, world area of every instance
     const size_t n = scene.instances.size();
     std::vector<InstanceUv> measures(n);
     size_t emptyCount = 0;
     for (size_t i = 0; i < n; ++i) {
-        measures[i] = measureInstance(scene, i);
+        const int mi = scene.instances[i].mesh;
+        measures[i] = measureInstance(scene, i, generatedNow(mi) || scene.meshes[size_t(mi)].uv1Grid.x > 0);
+        if (generatedNow(mi)) measures[i].grid = glm::ivec2(0);  // sized below
         const InstanceUv& m = measures[i];
         if (!std::isfinite(m.worldArea) || !std::isfinite(m.uvArea) || !std::isfinite(m.uvMin.x) ||
             !std::isfinite(m.uvMin.y) || !std::isfinite(m.uvMax.x) || !std::isfinite(m.uvMax.y))
@@ -353,21 +387,83 @@ Expected<Layout> computeLayout(const Scene& scene, const LayoutOptions& options)
         if (m.empty()) ++emptyCount;
     }
     auto overrideOf = [&](size_t i) { return double(scene.instances[i].texelDensity); };
+    // the density override of each generated mesh (its instances share one)
+    std::vector<double> meshOverride(scene.meshes.size(), 0.0);
+    for (size_t i = 0; i < n; ++i) meshOverride[size_t(scene.instances[i].mesh)] = overrideOf(i);
 
     // sizes of every rectangle at global density `density`
     std::vector<RectSize> sizes(n);
+    std::vector<RectSize> meshSizes(scene.meshes.size());
+    int unfitMesh = -1;  // a generated mesh whose charts do not fit a page at any density
+    auto sizeGenerated = [&](int mi, double density) {
+        const MeshCharts& charts = *gen->charts[size_t(mi)];
+        ChartPacking& pk = gen->packing[size_t(mi)];
+        RectSize& r = meshSizes[size_t(mi)];
+        const double d = meshOverride[size_t(mi)] > 0.0 ? meshOverride[size_t(mi)] : density;
+        auto fits = [&](const ChartPacking& p) { return p.width <= maxSide && p.height <= maxSide; };
+        pk = packCharts(charts, d, pad);
+        r.clamped = false;
+        if (!fits(pk)) {
+            // the largest density (bisection) at which the grid fits the page
+            r.clamped = true;
+            ChartPacking best = packCharts(charts, 0.0, pad);
+            if (!fits(best)) {
+                unfitMesh = mi;
+            } else {
+                double lo = 0.0, hi = d;
+                for (int k = 0; k < 30; ++k) {
+                    const double mid = 0.5 * (lo + hi);
+                    ChartPacking p = packCharts(charts, mid, pad);
+                    if (fits(p)) {
+                        lo = mid;
+                        best = std::move(p);
+                    } else {
+                        hi = mid;
+                    }
+                }
+            }
+            pk = std::move(best);
+        }
+        r.width = std::clamp(pk.width, 1, std::max(maxSide, 1));
+        r.height = std::clamp(pk.height, 1, std::max(maxSide, 1));
+        r.density = pk.texelsPerUnit;
+    };
     auto sizeAll = [&](double density) {
         double total = 0.0;
+        if (gen)
+            for (size_t mi = 0; mi < scene.meshes.size(); ++mi)
+                if (gen->charts[mi]) sizeGenerated(int(mi), density);
         for (size_t i = 0; i < n; ++i) {
-            const double d = overrideOf(i) > 0.0 ? overrideOf(i) : density;
-            sizes[i] = rectSize(measures[i], d, res, pad);
+            const int mi = scene.instances[i].mesh;
+            if (generatedNow(mi)) {
+                sizes[i] = meshSizes[size_t(mi)];
+            } else if (measures[i].grid.x > 0) {
+                // generated before: its grid, whatever the density (shrunk if it no longer fits)
+                RectSize& r = sizes[i];
+                r.width = std::min(measures[i].grid.x, maxSide);
+                r.height = std::min(measures[i].grid.y, maxSide);
+                r.clamped = r.width < measures[i].grid.x || r.height < measures[i].grid.y;
+                r.density = 0.0;
+            } else {
+                const double d = overrideOf(i) > 0.0 ? overrideOf(i) : density;
+                sizes[i] = rectSize(measures[i], d, res, pad);
+            }
             total += paddedArea(sizes[i], pad);
         }
         return total;
     };
+    auto unfitError = [&]() {
+        const MeshCharts& charts = *gen->charts[size_t(unfitMesh)];
+        const ChartPacking p = packCharts(charts, 0.0, pad);
+        return Status::error("mesh " + meshName(scene, unfitMesh) + " has " + std::to_string(charts.chartCount()) +
+                             " light map charts; even at one texel each with " + std::to_string(pad) +
+                             " texels between them they take " + std::to_string(p.width) + "x" +
+                             std::to_string(p.height) + " texels, more than a " + std::to_string(res) + "x" +
+                             std::to_string(res) + " page holds. Raise --resolution");
+    };
 
     Layout layout;
-    layout.mode = UvLayout::Pack;
+    layout.mode = options.mode;
     layout.resolution = res;
     layout.padding = pad;
     layout.rects.resize(n);
@@ -383,6 +479,7 @@ Expected<Layout> computeLayout(const Scene& scene, const LayoutOptions& options)
     double density = options.texelDensity;
     if (density > 0.0) {
         sizeAll(density);
+        if (unfitMesh >= 0) return unfitError();
         layout.pageCount = place();
     } else {
         // auto: density = m * base, with base the density at which the
@@ -392,13 +489,20 @@ Expected<Layout> computeLayout(const Scene& scene, const LayoutOptions& options)
         const double page = double(res) * double(res);
         double boxArea = 0.0;  // sum of A_w * bbox / A_uv: texel area at density 1
         for (size_t i = 0; i < n; ++i) {
-            if (overrideOf(i) > 0.0 || measures[i].empty()) continue;
+            const int mi = scene.instances[i].mesh;
+            if (overrideOf(i) > 0.0 || measures[i].empty() || measures[i].grid.x > 0) continue;
+            if (generatedNow(mi)) {
+                const MeshCharts& charts = *gen->charts[size_t(mi)];
+                for (const glm::dvec2& e : charts.extent) boxArea += e.x * e.y;
+                continue;
+            }
             const glm::dvec2 s = measures[i].uvSize();
             boxArea += measures[i].worldArea * (s.x * s.y) / measures[i].uvArea;
         }
         const double base = boxArea > 0.0 ? std::sqrt(AUTO_FILL * page / boxArea) : 0.0;
         double target = AUTO_FILL * page;
-        const double minimum = sizeAll(0.0);  // every auto-density instance 1x1
+        const double minimum = sizeAll(0.0);  // every auto-density instance 1x1 (generated: charts 1x1)
+        if (unfitMesh >= 0) return unfitError();
         bool fitOnePage = true;
         if (minimum > target) {
             // more instances than one page holds: give each some texels and
@@ -463,5 +567,153 @@ Expected<Layout> computeLayout(const Scene& scene, const LayoutOptions& options)
                    "a 1x1 light map rectangle");
     return layout;
 }
+
+bool closeMetric(const glm::dmat3& a, const glm::dmat3& b) {
+    double scale = 0.0, diff = 0.0;
+    for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r) {
+            scale = std::max(scale, std::abs(a[c][r]));
+            diff = std::max(diff, std::abs(a[c][r] - b[c][r]));
+        }
+    return diff <= 1e-6 * scale;
+}
+
+}  // namespace
+
+Expected<Layout> computeLayout(const Scene& scene, const LayoutOptions& options) {
+    if (Status s = validate(scene, options); !s) return s;
+
+    if (options.mode == UvLayout::Asset) {
+        if (Status s = requireUv1(scene, "--uv-layout asset uses TEXCOORD_1 as the atlas; add a second UV set "
+                                         "in the exporting tool, or use --uv-layout pack or generate");
+            !s)
+            return s;
+        Layout layout = assetLayout(scene, options);
+        if (Status s = checkOverlaps(scene, options, layout); !s) return s;
+        return layout;
+    }
+    return packLayout(scene, options, nullptr);
+}
+
+Expected<Layout> computeLayout(Scene& scene, const LayoutOptions& options) {
+    if (options.mode == UvLayout::Asset) return computeLayout(std::as_const(scene), options);
+    if (Status s = validate(scene, options); !s) return s;
+    using Clock = std::chrono::steady_clock;
+    const auto start = Clock::now();
+
+    // which meshes get generated TEXCOORD_1, and their instances
+    std::vector<std::vector<size_t>> instancesOf(scene.meshes.size());
+    for (size_t i = 0; i < scene.instances.size(); ++i) instancesOf[size_t(scene.instances[i].mesh)].push_back(i);
+    std::vector<int> need;
+    for (size_t m = 0; m < scene.meshes.size(); ++m) {
+        if (instancesOf[m].empty()) continue;
+        bool missing = options.mode == UvLayout::Generate;
+        for (const Primitive& prim : scene.meshes[m].primitives)
+            if (prim.triangleCount() > 0 && prim.uv1.size() != prim.positions.size()) missing = true;
+        if (missing) need.push_back(int(m));
+    }
+    if (need.empty()) return computeLayout(std::as_const(scene), options);
+
+    // one generated mesh per instance shape: instances whose linear parts
+    // differ only by a rotation (same L^T L) and that share a density
+    // override share the mesh and its TEXCOORD_1; the others get copies
+    struct Group {
+        int mesh;
+        glm::dmat3 metricFromObject;
+        glm::dmat3 metric;
+        float texelDensity;
+    };
+    std::vector<Group> groups;
+    size_t copies = 0;
+    for (int m : need) {
+        const size_t firstGroup = groups.size();
+        for (size_t i : instancesOf[size_t(m)]) {
+            Instance& inst = scene.instances[i];
+            const glm::dmat3 linear(inst.exactWorldFromObject());
+            const glm::dmat3 metric = glm::transpose(linear) * linear;
+            size_t g = firstGroup;
+            while (g < groups.size() && !(groups[g].texelDensity == inst.texelDensity && closeMetric(groups[g].metric, metric)))
+                ++g;
+            if (g == groups.size()) {
+                int mesh = m;
+                if (g > firstGroup) {
+                    Mesh copy = scene.meshes[size_t(m)];
+                    scene.meshes.push_back(std::move(copy));
+                    mesh = int(scene.meshes.size()) - 1;
+                    ++copies;
+                }
+                groups.push_back({mesh, linear, metric, inst.texelDensity});
+            }
+            inst.mesh = groups[g].mesh;
+        }
+    }
+
+    // charts, one mesh per task on every core (each mesh is its own; same bytes in any order)
+    std::vector<MeshCharts> charts(groups.size());
+    {
+        std::atomic<size_t> next{0};
+        auto work = [&]() {
+            for (size_t g; (g = next++) < groups.size();)
+                charts[g] = makeCharts(scene.meshes[size_t(groups[g].mesh)], groups[g].metricFromObject, options.charts);
+        };
+        const size_t threads = std::min<size_t>({std::max(1u, std::thread::hardware_concurrency()), groups.size(), 16});
+        std::vector<std::thread> pool;
+        for (size_t k = 1; k < threads; ++k) pool.emplace_back(work);
+        work();
+        for (std::thread& t : pool) t.join();
+    }
+    const auto charted = Clock::now();
+
+    GeneratedMeshes gen;
+    gen.charts.assign(scene.meshes.size(), nullptr);
+    gen.packing.resize(scene.meshes.size());
+    for (size_t g = 0; g < groups.size(); ++g) gen.charts[size_t(groups[g].mesh)] = &charts[g];
+    Expected<Layout> layout = packLayout(scene, options, &gen);
+    if (!layout) return layout;
+    for (const Group& g : groups) writeUv1(scene.meshes[size_t(g.mesh)], *gen.charts[size_t(g.mesh)], gen.packing[size_t(g.mesh)]);
+    const auto packed = Clock::now();
+
+    // figures
+    UvGenerationStats& st = layout->uv;
+    st.meshes = groups.size();
+    st.copiedMeshes = copies;
+    double stretchArea = 0.0, area = 0.0;
+    std::vector<size_t> uses(scene.meshes.size(), 0);
+    for (const Instance& inst : scene.instances) ++uses[size_t(inst.mesh)];
+    for (size_t g = 0; g < groups.size(); ++g) {
+        const MeshCharts& c = charts[g];
+        const int mi = groups[g].mesh;
+        const ChartPacking& pk = gen.packing[size_t(mi)];
+        st.charts += c.chartCount();
+        for (size_t k = 0; k < c.chartCount(); ++k) {
+            st.lscmCharts += c.lscm[k];
+            st.worstStretch = std::max(st.worstStretch, c.stretch[k]);
+            stretchArea += c.stretch[k] * c.area[k];
+            area += c.area[k];
+            if (c.area[k] * pk.texelsPerUnit * pk.texelsPerUnit < 1.0) ++st.subTexelCharts;
+        }
+        const GridCoverage cov = gridCoverage(scene.meshes[size_t(mi)], pk.width, pk.height);
+        st.gridTexels += size_t(pk.width) * size_t(pk.height) * uses[size_t(mi)];
+        st.coveredTexels += cov.covered * uses[size_t(mi)];
+        st.overlappingTexels += cov.overlapping * uses[size_t(mi)];
+    }
+    st.meanStretch = area > 0.0 ? stretchArea / area : 1.0;
+    st.chartSeconds = std::chrono::duration<double>(charted - start).count();
+    st.packSeconds = std::chrono::duration<double>(packed - charted).count();
+    if (st.overlappingTexels > 0)
+        logWarning(std::to_string(st.overlappingTexels) + " texel(s) of the generated light map UVs lie in two "
+                   "triangles (overlapping charts)");
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  "generated light map UVs for %zu mesh(es): %zu charts (%zu by LSCM), worst stretch %.3f, "
+                  "%.1f %% of their texels covered, %.2f s",
+                  st.meshes, st.charts, st.lscmCharts, st.worstStretch,
+                  st.gridTexels ? 100.0 * double(st.coveredTexels) / double(st.gridTexels) : 0.0,
+                  st.chartSeconds + st.packSeconds);
+    logDebug(line);
+    return layout;
+}
+
+TexelCoverage measureCoverage(const Scene& scene, const Layout& layout) { return coverage(scene, layout); }
 
 }  // namespace bb

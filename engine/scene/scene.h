@@ -55,6 +55,10 @@ struct Primitive {
 struct Mesh {
     std::string name;
     std::vector<Primitive> primitives;
+    // TEXCOORD_1 made by bundlebake (engine/layout/uv_generate.h): the texel
+    // grid its charts were packed on, uv1 = texel / uv1Grid, so the pack layout
+    // gives the mesh exactly this rectangle. 0 = TEXCOORD_1 from the file (or none).
+    glm::ivec2 uv1Grid{0};
 };
 
 // A node that references a mesh. Several instances may share one mesh; each

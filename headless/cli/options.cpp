@@ -15,8 +15,10 @@ int fail(const std::string& message) {
 
 void addSceneOptions(CLI::App& cmd, SceneArgs& a) {
     cmd.add_option("scene", a.scene, "glTF 2.0 scene (.gltf or .glb)")->required();
-    cmd.add_option("--uv-layout", a.uvLayout, "Light map layout: pack (a rectangle per instance) or asset (TEXCOORD_1 as one atlas)")
-        ->check(CLI::IsMember({"pack", "asset"}))
+    cmd.add_option("--uv-layout", a.uvLayout,
+                   "Light map layout: pack (a rectangle per instance; TEXCOORD_1 generated where a mesh has none), "
+                   "generate (pack, with TEXCOORD_1 generated for every mesh) or asset (TEXCOORD_1 as one atlas)")
+        ->check(CLI::IsMember({"pack", "generate", "asset"}))
         ->capture_default_str();
     cmd.add_option("--uv-overlap", a.uvOverlap,
                    "Overlapping TEXCOORD_1 charts under --uv-layout asset: warn (count and where) or fail")
@@ -85,6 +87,14 @@ Status loadEnvironment(const std::string& path, std::optional<io::ImageRgb>& env
     return Status::ok();
 }
 
+UvLayout parseUvLayout(const std::string& name) {
+    return name == "asset" ? UvLayout::Asset : name == "generate" ? UvLayout::Generate : UvLayout::Pack;
+}
+
+const char* uvLayoutName(UvLayout mode) {
+    return mode == UvLayout::Asset ? "asset" : mode == UvLayout::Generate ? "generate" : "pack";
+}
+
 Expected<LoadedScene> loadSceneAndLayout(const SceneArgs& a) {
     auto albedo = parseColor(a.defaultAlbedo, "--default-albedo");
     if (!albedo) return albedo.status();
@@ -93,7 +103,7 @@ Expected<LoadedScene> loadSceneAndLayout(const SceneArgs& a) {
     auto scene = loadScene(a.scene, lo);
     if (!scene) return scene.status();
     LayoutOptions opts;
-    opts.mode = a.uvLayout == "asset" ? UvLayout::Asset : UvLayout::Pack;
+    opts.mode = parseUvLayout(a.uvLayout);
     opts.failOnOverlap = a.uvOverlap == "fail";
     opts.resolution = a.resolution;
     opts.texelDensity = a.texelDensity;
@@ -112,10 +122,11 @@ int runInfo(const InfoArgs& args) {
     auto scene = loadScene(args.scene.scene, lo);
     if (!scene) return fail(scene.error());
     LayoutOptions opts;
-    opts.mode = args.scene.uvLayout == "asset" ? UvLayout::Asset : UvLayout::Pack;
+    opts.mode = parseUvLayout(args.scene.uvLayout);
     opts.resolution = args.scene.resolution;
     opts.texelDensity = args.scene.texelDensity;
-    auto layout = computeLayout(*scene, opts);
+    const bool hadUv1 = scene->allHaveUv1();
+    auto layout = computeLayout(*scene, opts);  // generates TEXCOORD_1 where the layout needs it
     const Scene& s = *scene;
     size_t emissiveMaterials = 0;
     for (const auto& m : s.materials)
@@ -138,7 +149,7 @@ int runInfo(const InfoArgs& args) {
     std::printf("bounds       min (%.4g, %.4g, %.4g) max (%.4g, %.4g, %.4g) size (%.4g, %.4g, %.4g) scene units\n",
                 s.bounds.min.x, s.bounds.min.y, s.bounds.min.z, s.bounds.max.x, s.bounds.max.y, s.bounds.max.z, size.x,
                 size.y, size.z);
-    std::printf("uv1          %s\n", s.allHaveUv1() ? "present on every primitive" : "missing on some primitives");
+    std::printf("uv1          %s\n", hadUv1 ? "present on every primitive" : "missing on some primitives");
     if (!layout) {
         std::printf("layout       none: %s\n", layout.error().c_str());
         return 0;
@@ -147,10 +158,28 @@ int runInfo(const InfoArgs& args) {
     size_t coveredTexels = 0;
     for (const auto& r : l.rects) coveredTexels += size_t(r.width) * r.height;
     if (l.mode == UvLayout::Asset) coveredTexels = l.texelCount();
-    std::printf("layout       %s, %d page(s) of %dx%d texels, padding %d\n", l.mode == UvLayout::Asset ? "asset" : "pack",
-                l.pageCount, l.resolution, l.resolution, l.padding);
-    if (l.mode == UvLayout::Pack) std::printf("density      %.6g texels per scene unit\n", l.texelDensity);
+    std::printf("layout       %s, %d page(s) of %dx%d texels, padding %d\n", uvLayoutName(l.mode), l.pageCount,
+                l.resolution, l.resolution, l.padding);
+    if (l.mode != UvLayout::Asset) std::printf("density      %.6g texels per scene unit\n", l.texelDensity);
     std::printf("texels       %zu in pages, %zu inside instance rectangles\n", l.texelCount(), coveredTexels);
+    const UvGenerationStats& uv = l.uv;
+    if (uv.meshes > 0) {
+        std::printf("generated    TEXCOORD_1 for %zu mesh(es) (%zu copies for instances of another size or shape) "
+                    "in %.2f s (charts %.2f s, packing %.2f s)\n",
+                    uv.meshes, uv.copiedMeshes, uv.chartSeconds + uv.packSeconds, uv.chartSeconds, uv.packSeconds);
+        std::printf("charts       %zu (%zu flattened by LSCM, %zu planar; %zu smaller than a texel)\n", uv.charts,
+                    uv.lscmCharts, uv.charts - uv.lscmCharts, uv.subTexelCharts);
+        std::printf("stretch      worst %.4f, mean %.4f (chart L2 stretch, 1 = none)\n", uv.worstStretch, uv.meanStretch);
+        std::printf("utilisation  %.1f %% (%zu covered of %zu texels in the generated meshes' rectangles; "
+                    "%zu in two charts)\n",
+                    uv.gridTexels ? 100.0 * double(uv.coveredTexels) / double(uv.gridTexels) : 0.0, uv.coveredTexels,
+                    uv.gridTexels, uv.overlappingTexels);
+    }
+    const TexelCoverage cov = measureCoverage(s, l);
+    std::printf("covered      %zu texel centres inside triangles: %.1f %% of the pages, %.1f %% of the rectangles; "
+                "%zu inside two\n",
+                cov.covered, l.texelCount() ? 100.0 * double(cov.covered) / double(l.texelCount()) : 0.0,
+                coveredTexels ? 100.0 * double(cov.covered) / double(coveredTexels) : 0.0, cov.overlapping);
     return 0;
 }
 

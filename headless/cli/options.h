@@ -19,7 +19,7 @@ namespace bb::cli {
 
 struct SceneArgs {
     std::string scene;
-    std::string uvLayout = "pack";
+    std::string uvLayout = "pack";      // pack | generate | asset
     std::string uvOverlap = "warn";
     int resolution = 512;
     float texelDensity = 0.0f;
@@ -67,7 +67,12 @@ struct LoadedScene {
     Scene scene;
     Layout layout;
 };
+// Generates TEXCOORD_1 where the layout needs it (see computeLayout(Scene&)).
 Expected<LoadedScene> loadSceneAndLayout(const SceneArgs& args);
+
+// --uv-layout's names.
+UvLayout parseUvLayout(const std::string& name);
+const char* uvLayoutName(UvLayout mode);
 
 // Command registration: adds the subcommand to `app`; when it is parsed, its
 // callback stores the command's run function into `action`.
