@@ -11,6 +11,7 @@ libglm-dev libopenimageio-dev libimath-dev libtinygltf-dev libstb-dev
 nlohmann-json3-dev libcli11-dev libgtest-dev libembree-dev
 libglfw3-dev libimgui-dev xvfb xauth python3-matplotlib openimageio-tools libeigen3-dev
 clang libclang-rt-14-dev
+libopenmpi-dev openmpi-bin
 "
 
 missing=""

@@ -104,7 +104,8 @@ nlohmann::json BakeStats::toJson() const {
     j["throughput"] = {{"fragments", fragments}, {"fragments_per_second_bundle_pass", fragments / bundleSeconds},
                        {"texel_samples", updatedTexels}, {"texel_samples_per_second_update_pass", updatedTexels / updateSeconds}};
     j["seconds"] = {{"setup", secondsSetup}, {"importance", secondsImportance}, {"tiling", secondsTiling}, {"sun", secondsSun}, {"emitters", secondsEmitters}, {"bundle", secondsBundle}, {"update", secondsUpdate},
-                    {"resolve", secondsResolve}, {"total", secondsTotal()}};
+                    {"resolve", secondsResolve}, {"combine", secondsCombine}, {"total", secondsTotal()}};
+    if (combines > 0) j["combine"] = {{"count", combines}, {"bytes_sent", combineBytes}};
     return j;
 }
 
@@ -296,6 +297,9 @@ Status Baker::Impl::init(const Scene& scene) {
     inputKey = hashInputs(scene);
     stats.directionsTotal = options.directions;
     if (options.directions < 1) return Status::error("--directions must be at least 1");
+    if (options.share && (options.share->count() < 1 || options.share->index() < 0 ||
+                          options.share->index() >= options.share->count()))
+        return Status::error("a direction share needs 0 <= index < count");
     if (mesh.triangles.empty()) return Status::error("nothing to bake: the scene has no triangles");
 
     GLint maxTex = 0, maxLayers = 0;
@@ -562,7 +566,7 @@ BakeProgress Baker::stepTiles(double seconds) {
 }
 
 BakeProgress Baker::progress() const {
-    return {impl_->stats.directionsDone, impl_->options.directions, impl_->directionActive};
+    return {impl_->stats.directionsDone, impl_->options.directions, impl_->directionActive, impl_->combined};
 }
 
 LightmapPages Baker::readLightmaps() {

@@ -22,6 +22,7 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include "bake/direction_share.h"
 #include "bake/rounding.h"
 #include "core/status.h"
 #include "io/image_io.h"
@@ -71,6 +72,10 @@ struct BakeOptions {
     int emitterSamples = 128;         // visibility samples over all explicit emitters (>= 1 per triangle)
     int emitterShadowSize = 0;        // cube face size of each sample's distance map; 0 = from the bundle
                                       // resolution (4 cube texels per bundle pixel), 64..512
+    // Directions shared with other bakers (MPI ranks; bake/direction_share.h):
+    // this one bakes every count()-th direction and combines accumulators with
+    // the others at each refresh. Null: the bake is this baker's alone.
+    std::shared_ptr<DirectionShare> share;
 };
 
 // Figures every bake reports (stats.json).
@@ -109,9 +114,14 @@ struct BakeStats {
     double secondsImportance = 0;     // part of setup
     double secondsTiling = 0;         // cluster projection, quadtree and prediction (CPU), per direction
     double secondsSetup = 0, secondsSun = 0, secondsBundle = 0, secondsUpdate = 0, secondsResolve = 0;
+    // shared bakes: accumulators combined at refreshes (read back, summed with
+    // the other bakers, stored), and the bytes this baker sent to the sum each time
+    int64_t combines = 0;
+    int64_t combineBytes = 0;
+    double secondsCombine = 0;        // all of it, including the share's waiting and transfer
     double secondsTotal() const {
         return secondsSetup + secondsSun + secondsEmitters + secondsTiling + secondsBundle + secondsUpdate +
-               secondsResolve;
+               secondsResolve + secondsCombine;
     }
     nlohmann::json toJson() const;
 };
@@ -120,6 +130,9 @@ struct BakeProgress {
     int directionsDone = 0;
     int directionsTotal = 0;
     bool midDirection = false;  // stepTiles stopped between a direction's tiles
+    // shared bakes: the accumulators are combined (the last round ended on a
+    // refresh), so a checkpoint may be written now
+    bool combined = true;
     bool done() const { return directionsDone >= directionsTotal; }
 };
 

@@ -74,6 +74,9 @@ struct Baker::Impl {
     // the direction in progress (Baker::stepTiles can stop between its tiles)
     bool directionActive = false;
     BundleTracer::UpdateFn directionUpdate;
+    // shared bakes: the accumulators hold the combined sums (baker 0) or nothing (the others)
+    bool combined = true;
+    std::vector<std::vector<uint32_t>> coveredTexelIndex;  // per page, the covered texels (combines)
 
     Status init(const Scene& scene);
     static uint64_t hashInputs(const Scene& scene);  // inputKey (checkpoint.cpp)
@@ -93,13 +96,20 @@ struct Baker::Impl {
     // The root square of direction d: the uniform grid, or the adaptive root.
     // jitter: in units of jitterUnit (scene units) in adaptive roots, of the uniform pixel otherwise.
     BundleFrame bundleFrame(const glm::vec3& d, glm::vec2 jitter, bool uniformGrid, double jitterUnit) const;
-    // Direction k: the history ramp, then its tiles one by one, then the radiance refresh.
+    // Direction k: the history ramp, then its tiles one by one; the round's end
+    // (bake/direction_share.h), with the refresh when one is due.
     void beginDirection(int k);
     void stepTile();
     void stepDirection();  // tiles until the direction in flight (or the next) is done
     // Baker::step (whole directions) and stepTiles: until `seconds` have passed, at least one step.
     void run(double seconds, bool wholeDirections);
-    void finishDirection(int k);
+    void finishRound(int round);
+    // Shared bakes: every baker's accumulators summed (weights and weighted
+    // means) and stored on baker 0; the others keep only what they add next.
+    void combineShares(int round);
+    int shareIndex() const { return options.share ? options.share->index() : 0; }
+    int shareCount() const { return options.share ? options.share->count() : 1; }
+    int rounds() const { return (options.directions + shareCount() - 1) / shareCount(); }
     void noteMemory();  // peaks into stats
     // The outgoing radiance the bundles read: meta.frag over every page, then the padding.
     void refreshRadiance(uint32_t key);  // key: the direction just done (random numbers)

@@ -17,7 +17,7 @@
 namespace bb {
 
 namespace {
-constexpr char CHECKPOINT_MAGIC[8] = {'B', 'B', 'C', 'K', 'P', 'T', '0', '4'};
+constexpr char CHECKPOINT_MAGIC[8] = {'B', 'B', 'C', 'K', 'P', 'T', '0', '5'};
 
 uint64_t fnv1a(const void* data, size_t bytes, uint64_t h = 1469598103934665603ull) {
     const auto* p = static_cast<const uint8_t*>(data);
@@ -38,6 +38,8 @@ uint64_t checkpointKey(const Baker::Impl& m) {
     h = fnv1a(ints, sizeof ints, h);
     const double reals[] = {o.sky.r, o.sky.g, o.sky.b, m.historyPower};
     h = fnv1a(reals, sizeof reals, h);
+    // a shared bake's bytes depend on how many bakers share it (a bake alone keeps its key)
+    if (const int32_t bakers = m.shareCount(); bakers > 1) h = fnv1a(&bakers, sizeof bakers, h);
     if (o.environment) h = fnv1a(o.environment->pixels.data(), o.environment->pixels.size() * sizeof(glm::vec3), h);
     return fnv1a(&m.inputKey, sizeof m.inputKey, h);  // materials, their textures, lights
 }
@@ -48,6 +50,7 @@ nlohmann::json statsCounters(const BakeStats& s) {
             {"updated_texels", s.updatedTexels}, {"peak_nodes_per_tile", s.peakNodesPerTile},
             {"bundle_triangles_drawn", s.bundleTrianglesDrawn}, {"update_triangles_drawn", s.updateTrianglesDrawn},
             {"seconds", {s.secondsTiling, s.secondsBundle, s.secondsUpdate, s.secondsResolve}},
+            {"combines", {s.combines, s.combineBytes, s.secondsCombine}},
             {"predicted_over_actual", s.predictedOverActual}, {"tiles_per_direction", s.tilesPerDirection},
             {"leaves_per_direction", s.leavesPerDirection}, {"tile_pixel_sizes", s.tilePixelSizes}};
 }
@@ -66,6 +69,10 @@ bool restoreStatsCounters(const nlohmann::json& j, BakeStats& s) {
         s.secondsBundle = t.at(1);
         s.secondsUpdate = t.at(2);
         s.secondsResolve = t.at(3);
+        const auto& c = j.at("combines");
+        s.combines = c.at(0);
+        s.combineBytes = c.at(1);
+        s.secondsCombine = c.at(2);
         s.predictedOverActual = j.at("predicted_over_actual").get<std::vector<double>>();
         s.tilesPerDirection = j.at("tiles_per_direction").get<std::vector<int>>();
         s.leavesPerDirection = j.at("leaves_per_direction").get<std::vector<int>>();
@@ -107,6 +114,19 @@ Status Baker::saveCheckpoint(const std::string& path) {
     Impl& m = *impl_;
     // a checkpoint holds whole directions: finish the one in flight (the same tiles an uninterrupted bake draws)
     if (m.directionActive) m.stepDirection();
+    // a shared bake: every baker calls this after a combine; baker 0 writes the
+    // sums it holds and every baker's counters, and all return once it is written
+    std::string counters = statsCounters(m.stats).dump();
+    if (m.shareCount() > 1) {
+        if (!m.combined) return Status::error("a shared bake's checkpoint must follow a combine");
+        nlohmann::json all = nlohmann::json::array();
+        for (const std::string& c : m.options.share->gather(counters)) all.push_back(nlohmann::json::parse(c));
+        counters = all.dump();
+        if (m.shareIndex() > 0) {
+            m.options.share->barrier();
+            return Status::ok();
+        }
+    }
     const int res = m.layout.resolution;
     const int pages = m.layout.pageCount;
     std::vector<glm::uvec2> raw(size_t(res) * res * pages);
@@ -124,12 +144,14 @@ Status Baker::saveCheckpoint(const std::string& path) {
     std::string bytes(reinterpret_cast<const char*>(&h), sizeof h);
     bytes.append(reinterpret_cast<const char*>(raw.data()), raw.size() * sizeof(glm::uvec2));
     bytes.append(reinterpret_cast<const char*>(radiance.data()), radiance.size() * sizeof(uint32_t));
-    // then the statistics so far (JSON, length first: doubles round-trip exactly)
-    const std::string counters = statsCounters(m.stats).dump();
+    // then the statistics so far (JSON, length first: doubles round-trip exactly;
+    // a shared bake's: an array, one per baker)
     const uint64_t countersBytes = counters.size();
     bytes.append(reinterpret_cast<const char*>(&countersBytes), sizeof countersBytes);
     bytes.append(counters);
-    return io::writeFileAtomic(path, bytes);
+    Status written = io::writeFileAtomic(path, bytes);
+    if (m.shareCount() > 1) m.options.share->barrier();
+    return written;
 }
 
 Status Baker::loadCheckpoint(const std::string& path) {
@@ -177,9 +199,14 @@ Status Baker::loadCheckpoint(const std::string& path) {
     if (h.key != checkpointKey(m))
         return Status::error(path + " was written for another scene or other bake options; remove it or bake without --resume");
     BakeStats restored = m.stats;
-    if (!restoreStatsCounters(nlohmann::json::parse(counters, nullptr, false), restored))
+    nlohmann::json parsed = nlohmann::json::parse(counters, nullptr, false);
+    if (m.shareCount() > 1)  // one per baker
+        parsed = parsed.is_array() && parsed.size() == size_t(m.shareCount()) ? parsed[size_t(m.shareIndex())]
+                                                                                : nlohmann::json();
+    if (!restoreStatsCounters(parsed, restored))
         return Status::error(path + ": corrupt statistics (remove it or bake without --resume)");
-    if (h.directionsDone < 0 || h.directionsDone > m.options.directions)
+    if (h.directionsDone < 0 || h.directionsDone > m.options.directions ||
+        (h.directionsDone % m.shareCount() != 0 && h.directionsDone != m.options.directions))
         return Status::error(path + ": corrupt progress count");
     gl::writeTexture(m.accum.id(), 0, 0, 0, res, res, m.layout.pageCount, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
     gl::writeTexture(m.radianceBits.id(), 0, 0, 0, res, res, m.layout.pageCount, GL_RED_INTEGER, GL_UNSIGNED_INT, 4,
@@ -187,6 +214,11 @@ Status Baker::loadCheckpoint(const std::string& path) {
     m.stats = restored;
     m.stats.directionsDone = h.directionsDone;
     m.accumScale = h.accumScale;
+    if (m.shareIndex() > 0) {  // the sums are baker 0's to hold
+        const GLuint zero[4] = {0, 0, 0, 0};
+        glClearTexImage(m.accum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, zero);
+    }
+    m.combined = true;
     return Status::ok();
 }
 

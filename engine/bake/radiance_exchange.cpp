@@ -10,6 +10,7 @@
 
 #include "bake/baker_impl.h"
 #include "bake/rounding.h"
+#include "gl/objects.h"
 #include "core/check.h"
 #include "core/memory.h"
 #include "gl/gl.h"
@@ -20,9 +21,10 @@ namespace bb {
 
 void Baker::Impl::beginDirection(int k) {
     const glm::vec3 d = directions[size_t(k)];
-    // history ramp: weight min(k+1, K)^power relative to the stored scale
-    double rampEnd = std::max(1, options.directions / 2);
-    double weight = std::pow(std::min(double(k + 1), rampEnd), historyPower);
+    // history ramp: weight min(j+1, rounds/2)^power relative to the stored
+    // scale, j the round (the direction, baked alone): a round adds a bounce
+    const double rampEnd = std::max(1, rounds() / 2);
+    const double weight = std::pow(std::min(double(k / shareCount() + 1), rampEnd), historyPower);
     double sampleWeight = weight / accumScale;
     if (sampleWeight > 16.0) {
         gl::DebugGroup group("rescale accumulators");
@@ -55,26 +57,95 @@ void Baker::Impl::beginDirection(int k) {
 
 void Baker::Impl::stepTile() {
     MemoryCategory category("bundles");
-    const int k = stats.directionsDone;
-    if (!directionActive) beginDirection(k);
-    if (!tracer->done()) tracer->next(directionUpdate);
-    if (tracer->done()) finishDirection(k);
+    const int round = stats.directionsDone / shareCount();
+    const int k = stats.directionsDone + shareIndex();
+    if (k < options.directions) {  // the last round may have no direction for this baker
+        if (!directionActive) beginDirection(k);
+        if (!tracer->done()) tracer->next(directionUpdate);
+        if (!tracer->done()) return;
+        directionActive = false;
+        stats.updatedTexels += stats.coveredTexels;
+        combined = false;
+    }
+    finishRound(round);
 }
 
-void Baker::Impl::finishDirection(int k) {
-    directionActive = false;
-    stats.updatedTexels += stats.coveredTexels;
-    // Refresh the outgoing radiance the next bundles read. Every direction at
-    // first, when each one adds a bounce; later every k/32 directions (at most
-    // 8): the estimate then moves slowly and the resolve is a pass over every page.
-    const int interval = std::clamp(k / 32, 1, 8);
-    if ((k + 1) % interval == 0 || k + 1 == options.directions) {
+void Baker::Impl::finishRound(int round) {
+    // Refresh the outgoing radiance the next bundles read. After every round
+    // at first, when each one adds a bounce; later every j/32 rounds (at most
+    // 8): the estimate then moves slowly and the refresh is a pass over every page.
+    const int interval = std::clamp(round / 32, 1, 8);
+    if ((round + 1) % interval == 0 || round + 1 == rounds()) {
         auto tr = Clock::now();
-        refreshRadiance(uint32_t(k));
+        combineShares(round);
+        stats.secondsCombine += secondsSince(tr);
+        tr = Clock::now();
+        refreshRadiance(uint32_t(round));
+        if (shareIndex() > 0) {  // what this baker adds from now on, alone: baker 0 holds the sums
+            const GLuint zero[4] = {0, 0, 0, 0};
+            glClearTexImage(accum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, zero);
+        }
         glFinish();
         stats.secondsResolve += secondsSince(tr);
+        combined = true;
     }
-    ++stats.directionsDone;
+    stats.directionsDone = std::min(options.directions, (round + 1) * shareCount());
+}
+
+void Baker::Impl::combineShares(int round) {
+    if (shareCount() == 1) return;
+    gl::DebugGroup group("combine accumulators");
+    DirectionShare& share = *options.share;
+    const int res = layout.resolution;
+    const size_t pageTexels = size_t(res) * res;
+    std::vector<glm::uvec2> raw(pageTexels);
+    if (coveredTexelIndex.empty()) {  // the texels the update pass writes: the others hold nothing to combine
+        std::vector<uint8_t> codes(pageTexels);
+        coveredTexelIndex.resize(size_t(layout.pageCount));
+        for (int p = 0; p < layout.pageCount; ++p) {
+            gl::readTexture(dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, codes.data());
+            for (size_t i = 0; i < pageTexels; ++i)
+                if (codes[i] == DILATION_SELF) coveredTexelIndex[size_t(p)].push_back(uint32_t(i));
+        }
+    }
+    // Sums relative to the round's ramp weight, which every baker knows (each
+    // one's accumScale follows its own rescales): weights W and W x mean.
+    const double scale = std::pow(std::min(double(round + 1), double(std::max(1, rounds() / 2))), historyPower);
+    const float toCommon = float(accumScale / scale);
+    const auto rnd = [this, round](size_t texel, uint32_t channel) {
+        return uniform01(pcgHash(uint32_t(options.seed) ^ pcgHash(uint32_t(texel) * 4u + channel) ^
+                                 pcgHash(uint32_t(round) + 0x68e31da4u)));
+    };
+    std::vector<float> sums;
+    for (int p = 0; p < layout.pageCount; ++p) {
+        const std::vector<uint32_t>& covered = coveredTexelIndex[size_t(p)];
+        gl::readTexture(accum.id(), 0, 0, p, res, res, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
+        sums.assign(covered.size() * 4, 0.0f);
+        for (size_t i = 0; i < covered.size(); ++i) {
+            const glm::uvec2 v = raw[covered[i]];
+            const float w = halfToFloat(uint16_t(v.y >> 16)) * toCommon;
+            sums[4 * i + 0] = halfToFloat(uint16_t(v.x & 0xFFFF)) * w;
+            sums[4 * i + 1] = halfToFloat(uint16_t(v.x >> 16)) * w;
+            sums[4 * i + 2] = halfToFloat(uint16_t(v.y & 0xFFFF)) * w;
+            sums[4 * i + 3] = w;
+        }
+        share.sum(sums.data(), sums.size());
+        stats.combineBytes += int64_t(sums.size() * sizeof(float));
+        // every baker stores the combined means (the outgoing pass reads them);
+        // the rounding's random numbers are the same on all, so are the bits
+        for (size_t i = 0; i < covered.size(); ++i) {
+            const float w = sums[4 * i + 3];
+            const glm::vec3 mean = w > 0.0f ? glm::vec3(sums[4 * i], sums[4 * i + 1], sums[4 * i + 2]) / w : glm::vec3(0.0f);
+            const size_t texel = size_t(p) * pageTexels + covered[i];
+            uint16_t h[4];
+            for (uint32_t c = 0; c < 3; ++c) h[c] = floatToHalf(mean[int(c)], options.rounding, rnd(texel, c));
+            h[3] = floatToHalf(w, options.rounding, rnd(texel, 3));
+            raw[covered[i]] = glm::uvec2(h[0] | uint32_t(h[1]) << 16, h[2] | uint32_t(h[3]) << 16);
+        }
+        gl::writeTexture(accum.id(), 0, 0, p, res, res, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
+    }
+    accumScale = scale;
+    ++stats.combines;
 }
 
 void Baker::Impl::refreshRadiance(uint32_t key) {

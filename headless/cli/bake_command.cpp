@@ -8,12 +8,14 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 
 #include "bake/baker.h"
 #include "core/log.h"
 #include "headless/cli/options.h"
 #include "bake/bake_output.h"
 #include "headless/cli/progress.h"
+#include "headless/mpi/mpi_share.h"
 #include "headless/platform.h"
 
 namespace bb::cli {
@@ -82,7 +84,39 @@ void addBakeCommand(CLI::App& app, std::function<int()>& action) {
     cmd->callback([args, &action] { action = [args] { return runBake(*args); }; });
 }
 
+namespace {
+// A shared bake's figures per rank (stats.json "mpi"): what each baked and how
+// long it waited for the others and moved bytes.
+nlohmann::json rankFigures(const BakeStats& s, const DirectionShare& share) {
+    char host[256] = {0};
+    gethostname(host, sizeof host - 1);
+    return {{"rank", share.index()}, {"host", host},
+            {"directions", (s.directionsTotal - share.index() + share.count() - 1) / share.count()},
+            {"tiles", s.tilesDrawn}, {"fragments", s.fragments}, {"texel_samples", s.updatedTexels},
+            {"seconds", {{"tiling", s.secondsTiling}, {"bundle", s.secondsBundle}, {"update", s.secondsUpdate},
+                         {"resolve", s.secondsResolve}, {"combine", s.secondsCombine},
+                         {"waiting", share.secondsWaiting()}, {"transferring", share.secondsTransferring()},
+                         {"total", s.secondsTotal()}}},
+            {"combines", s.combines}, {"bytes_sent", s.combineBytes}};
+}
+}  // namespace
+
 int runBake(const BakeArgs& args) {
+    // one of several MPI ranks: each bakes its share of the directions; rank 0 writes
+    auto started = MpiShare::startIfLaunched();
+    if (!started) return fail(started.error());
+    const std::shared_ptr<MpiShare> mpi = *started && (*started)->count() > 1 ? *started : nullptr;
+    const bool writer = !mpi || mpi->index() == 0;
+    if (!writer) {
+        setFailPrefix("rank " + std::to_string(mpi->index()) + ": ");
+        if (logLevel() < LogLevel::Error) setLogLevel(LogLevel::Error);  // rank 0 says it once
+    }
+    // a rank that fails ends the job: the others would wait for it in the next combine
+    const auto fail = [&mpi](const std::string& message) {
+        const int code = cli::fail(message);
+        if (mpi) mpi->abortAll(code);
+        return code;
+    };
     // until the bake starts, a refused input gives its one error line alone:
     // warnings about a scene that is then refused are dropped with it
     LogHold hold;
@@ -106,6 +140,7 @@ int runBake(const BakeArgs& args) {
                         : args.direct == "bundles"  ? BakeOptions::DirectLight::Bundles
                                                     : BakeOptions::DirectLight::Auto;
     options.emitterSamples = args.emitterSamples;
+    options.share = mpi;
     if (Status s = loadEnvironment(args.env, options.environment); !s) return fail(s.message());
     auto loaded = loadSceneAndLayout(args.scene);
     if (!loaded) return fail(loaded.error());
@@ -117,23 +152,33 @@ int runBake(const BakeArgs& args) {
     if (!baker) return fail(baker.error());
 
     const std::string checkpoint = args.outDir + "/checkpoint.bin";
-    if (args.resume && std::filesystem::exists(checkpoint)) {
+    bool resume = args.resume && std::filesystem::exists(checkpoint);
+    if (mpi && args.resume) {  // every rank reads the checkpoint: they must all see it, or none
+        const auto seen = mpi->gather(resume ? "1" : "0");
+        if (std::count(seen.begin(), seen.end(), "1") % mpi->count() != 0)
+            return fail("not every rank sees " + checkpoint + ": --resume under MPI needs the output directory shared by all ranks");
+    }
+    if (resume) {
         if (Status s = (*baker)->loadCheckpoint(checkpoint); !s) return fail(s.message());
         logInfo("resuming from " + checkpoint + " at direction " + std::to_string((*baker)->progress().directionsDone));
     }
     hold.release();  // the input is accepted: print what was said about it
-    ProgressBar bar(args.progress, isatty(STDERR_FILENO));
+    ProgressBar bar(args.progress && writer, isatty(STDERR_FILENO));
     auto t0 = std::chrono::steady_clock::now();
     int lastCheckpoint = (*baker)->progress().directionsDone;
     while (true) {
-        // one direction at a time when checkpointing: a checkpoint every N directions exactly
+        // one direction (a round of them under MPI) at a time when checkpointing: a checkpoint every N directions
+        // exactly (under MPI: at the first combine after N directions; every rank takes part, rank 0 writes)
         BakeProgress p = (*baker)->step(args.checkpointEvery > 0 ? 0.0 : 0.25);
         bar.update(p.directionsDone, p.directionsTotal);
-        if (args.checkpointEvery > 0 && p.directionsDone - lastCheckpoint >= args.checkpointEvery && !p.done()) {
+        if (args.checkpointEvery > 0 && p.directionsDone - lastCheckpoint >= args.checkpointEvery && p.combined &&
+            !p.done()) {
             if (Status s = (*baker)->saveCheckpoint(checkpoint); !s) return fail(s.message());
             lastCheckpoint = p.directionsDone;
-            // test hook: die as `kill -9` would, right after the n-th checkpoint (tests/gl/cli_resume_test.cpp)
-            if (const char* n = std::getenv("BUNDLEBAKE_TEST_KILL_AFTER_CHECKPOINTS"); n && --killCountdown(n) == 0)
+            // test hook: die as `kill -9` would, right after the n-th checkpoint (tests/gl/cli_resume_test.cpp);
+            // under MPI the last rank dies (tests/mpi)
+            if (const char* n = std::getenv("BUNDLEBAKE_TEST_KILL_AFTER_CHECKPOINTS");
+                n && --killCountdown(n) == 0 && (!mpi || mpi->index() == mpi->count() - 1))
                 std::raise(SIGKILL);
         }
         if (p.done()) break;
@@ -141,6 +186,22 @@ int runBake(const BakeArgs& args) {
     bar.finish();
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
+    nlohmann::json mpiFigures;
+    if (mpi) {
+        const std::vector<std::string> perRank = mpi->gather(rankFigures((*baker)->stats(), *mpi).dump());
+        if (!writer) return 0;
+        nlohmann::json ranks = nlohmann::json::array();
+        double communication = 0, total = 0;
+        for (const std::string& r : perRank) {
+            ranks.push_back(nlohmann::json::parse(r));
+            const auto& t = ranks.back()["seconds"];
+            communication += t["waiting"].get<double>() + t["transferring"].get<double>();
+            total += t["total"].get<double>();
+        }
+        mpiFigures = {{"ranks", mpi->count()}, {"per_rank", ranks},
+                      {"communication_share", total > 0 ? communication / total : 0.0},
+                      {"note", "the figures outside \"mpi\" are rank 0's own"}};
+    }
     BakeOutputInfo info;
     info.backend = backendName(*backend);
     info.renderer = context.value()->caps().renderer;
@@ -148,16 +209,18 @@ int runBake(const BakeArgs& args) {
                      {"seed", args.seed}, {"sky", args.sky}, {"env", args.env}, {"rounding", args.rounding},
                      {"uv_layout", args.scene.uvLayout}, {"resolution", args.scene.resolution},
                      {"texel_density", args.scene.texelDensity}, {"history_power", (*baker)->stats().historyPower},
-                     {"direct", args.direct}, {"emitter_samples", args.emitterSamples}};
+                     {"direct", args.direct}, {"emitter_samples", args.emitterSamples},
+                     {"mpi_ranks", mpi ? mpi->count() : 1}};
     info.wallSeconds = seconds;
     info.writePreviews = args.preview;
     LightmapPages maps = (*baker)->readLightmaps();  // before the stats: its read-back memory counts
-    if (Status s = writeBakeOutputs(args.outDir, loaded->scene, loaded->layout, maps, (*baker)->stats().toJson(), info);
-        !s)
+    nlohmann::json stats = (*baker)->stats().toJson();
+    if (mpi) stats["mpi"] = mpiFigures;
+    if (Status s = writeBakeOutputs(args.outDir, loaded->scene, loaded->layout, maps, stats, info); !s)
         return fail(s.message());
     if (args.checkpointEvery > 0 || args.resume) std::filesystem::remove(checkpoint);  // the outputs supersede it
     logInfo("baked " + std::to_string(options.directions) + " directions in " + std::to_string(seconds) + " s -> " +
-            args.outDir);
+            args.outDir + (mpi ? " (" + std::to_string(mpi->count()) + " MPI ranks)" : ""));
     return 0;
 }
 

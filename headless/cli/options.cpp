@@ -8,8 +8,17 @@
 
 namespace bb::cli {
 
+namespace {
+std::string& failPrefix() {
+    static std::string prefix;
+    return prefix;
+}
+}  // namespace
+
+void setFailPrefix(const std::string& prefix) { failPrefix() = prefix; }
+
 int fail(const std::string& message) {
-    std::fprintf(stderr, "bundlebake: error: %s\n", message.c_str());
+    std::fprintf(stderr, "bundlebake: %serror: %s\n", failPrefix().c_str(), message.c_str());
     return 1;
 }
 

@@ -88,5 +88,7 @@ int runBake(const BakeArgs& args);
 
 // Prints "bundlebake: error: <message>" to stderr and returns 1.
 int fail(const std::string& message);
+// Said before "error:" in fail()'s line (an MPI rank's number).
+void setFailPrefix(const std::string& prefix);
 
 }  // namespace bb::cli

@@ -211,14 +211,14 @@ def main():
     write("env/garbage.hdr", "#?RADIANCE\n" + "garbage " * 20)
 
     # --- checkpoints (--resume) ---------------------------------------------
-    def header(magic=b"BBCKPT04", key=0, done=1, res=16, pages=1, scale=1.0):
+    def header(magic=b"BBCKPT05", key=0, done=1, res=16, pages=1, scale=1.0):
         return magic + struct.pack("<Qiiiid", key, done, res, pages, 0, scale)
     maps = b"\0" * (16 * 16 * 12)                   # accumulators (8) + radiance (4) per texel
     stats = struct.pack("<Q", 2) + b"{}"             # the statistics block: length, JSON
     write("checkpoint/empty.bin", b"")
     write("checkpoint/garbage.bin", bytes((i * 101 + 7) % 256 for i in range(4096)))
     write("checkpoint/short_header.bin", header()[:20])
-    write("checkpoint/old_magic.bin", header(magic=b"BBCKPT03") + maps)
+    write("checkpoint/old_magic.bin", header(magic=b"BBCKPT04") + maps)
     write("checkpoint/other_resolution.bin", header(res=999) + maps + stats)
     write("checkpoint/truncated_payload.bin", header() + b"\0" * 100)
     write("checkpoint/other_scene_key.bin", header(key=0x0123456789abcdef) + maps + stats)

@@ -57,12 +57,11 @@ private:
     std::filesystem::path path_;
 };
 
-// Runs BUNDLEBAKE_CLI with `args` (no shell), stdout and stderr to files in `scratch`.
-inline CliResult runCli(const std::vector<std::string>& args, const TempDir& scratch) {
+// Runs `program` with `args` (no shell), stdout and stderr to files in `scratch`.
+inline CliResult runProgram(std::string exe, const std::vector<std::string>& args, const TempDir& scratch) {
     CliResult r;
     const std::string outPath = scratch / "cli-stdout.txt", errPath = scratch / "cli-stderr.txt";
     std::vector<char*> argv;
-    std::string exe = BUNDLEBAKE_CLI;
     std::vector<std::string> copy = args;
     argv.push_back(exe.data());
     for (auto& a : copy) argv.push_back(a.data());
@@ -90,6 +89,11 @@ inline CliResult runCli(const std::vector<std::string>& args, const TempDir& scr
     std::filesystem::remove(outPath, ec);
     std::filesystem::remove(errPath, ec);
     return r;
+}
+
+// Runs BUNDLEBAKE_CLI with `args`.
+inline CliResult runCli(const std::vector<std::string>& args, const TempDir& scratch) {
+    return runProgram(BUNDLEBAKE_CLI, args, scratch);
 }
 
 }  // namespace bb::test
