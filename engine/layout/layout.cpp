@@ -235,6 +235,12 @@ double paddedArea(const RectSize& s, int padding) {
     return double(s.width + 2 * padding) * double(s.height + 2 * padding);
 }
 
+// A texel centre closer than this to a triangle's edge (in texels) counts as
+// on the edge: inside neither side. Rounding of nearly collinear vertices
+// (T-junctions, slivers the loader keeps unless exactly degenerate) otherwise
+// puts a centre inside two triangles that overlap by 1e-4 texel.
+constexpr double EDGE_TOLERANCE = 1e-4;
+
 // Texel centres of the pages inside the instances' TEXCOORD_1 triangles
 // through their rectangles (strictly: a centre on a shared edge belongs to
 // neither side), counting those inside two. Asset layouts visit each mesh
@@ -271,7 +277,8 @@ TexelCoverage coverage(const Scene& scene, const Layout& layout) {
                         bool inside = true;
                         for (int k = 0; k < 3 && inside; ++k) {
                             const glm::dvec2 a = p[k], b = p[(k + 1) % 3];
-                            inside = sign * ((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x)) > 0.0;
+                            inside = sign * ((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x)) >
+                                     EDGE_TOLERANCE * glm::length(b - a);
                         }
                         if (!inside) continue;
                         int32_t& slot = page[size_t(y) * size_t(res) + size_t(x)];

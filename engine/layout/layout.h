@@ -99,7 +99,8 @@ Expected<Layout> computeLayout(Scene& scene, const LayoutOptions& options);
 
 // Texel centres of the pages inside the instances' TEXCOORD_1 triangles
 // (mapped by their rectangles; asset: each mesh once), and those inside two
-// or more: overlapping charts. A centre on a shared edge counts for neither.
+// or more: overlapping charts. A centre on (or within 1e-4 texel of) an edge
+// counts for neither side: nearly collinear vertices round by that much.
 struct TexelCoverage {
     size_t covered = 0;
     size_t overlapping = 0;

@@ -161,39 +161,37 @@ Topology buildTopology(const Mesh& mesh, const glm::dmat3& metricFromObject) {
     return topo;
 }
 
-// Charts grown breadth-first from the largest unassigned triangle: a
-// neighbour joins while its normal is within the hard angle of the triangle
-// it is reached from and within the cone of the seed's normal.
-std::vector<int32_t> growCharts(const Topology& topo, const UvChartOptions& options, size_t& chartCount) {
-    const size_t nt = topo.triangleCount();
-    const double cosHard = std::cos(double(options.hardAngleDegrees) * PI / 180.0);
-    const double cosCone = std::cos(double(options.coneAngleDegrees) * PI / 180.0);
-    const size_t maxTriangles = size_t(std::max(1, options.maxChartTriangles));
-    std::vector<uint32_t> order(nt);
-    std::iota(order.begin(), order.end(), 0u);
-    std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return topo.area[a] > topo.area[b]; });
-    std::vector<int32_t> chartOf(nt, -1);
-    std::vector<uint32_t> queue;
-    chartCount = 0;
-    for (uint32_t seed : order) {
-        if (chartOf[seed] >= 0) continue;
-        const int32_t c = int32_t(chartCount++);
+// Charts grown breadth-first from the largest available triangle among
+// `candidates` (mark -1; growing sets mark to >= 0): a neighbour joins while
+// its normal is within the hard angle of the triangle it is reached from and
+// within the cone of the seed's normal, up to maxTriangles.
+std::vector<std::vector<uint32_t>> growCharts(const Topology& topo, std::vector<uint32_t> candidates,
+                                              std::vector<int32_t>& mark, double cosHard, double cosCone,
+                                              size_t maxTriangles) {
+    std::stable_sort(candidates.begin(), candidates.end(),
+                     [&](uint32_t a, uint32_t b) { return topo.area[a] > topo.area[b]; });
+    std::vector<std::vector<uint32_t>> charts;
+    for (uint32_t seed : candidates) {
+        if (mark[seed] >= 0) continue;
+        const int32_t c = int32_t(charts.size());
         const glm::dvec3 n0 = topo.normal[seed];
-        queue.assign(1, seed);
-        chartOf[seed] = c;
+        std::vector<uint32_t> queue(1, seed);
+        mark[seed] = c;
         for (size_t head = 0; head < queue.size() && queue.size() < maxTriangles; ++head) {
             const uint32_t t = queue[head];
             for (int k = 0; k < 3 && queue.size() < maxTriangles; ++k) {
                 const int32_t u = topo.neighbour[3 * size_t(t) + size_t(k)];
-                if (u < 0 || chartOf[size_t(u)] >= 0) continue;
+                if (u < 0 || mark[size_t(u)] != -1) continue;
                 const glm::dvec3& nu = topo.normal[size_t(u)];
                 if (glm::dot(nu, topo.normal[t]) < cosHard || glm::dot(nu, n0) < cosCone) continue;
-                chartOf[size_t(u)] = c;
+                mark[size_t(u)] = c;
                 queue.push_back(uint32_t(u));
             }
         }
+        std::sort(queue.begin(), queue.end());  // mesh order
+        charts.push_back(std::move(queue));
     }
-    return chartOf;
+    return charts;
 }
 
 double cross2(const glm::dvec2& a, const glm::dvec2& b) { return a.x * b.y - a.y * b.x; }
@@ -357,6 +355,63 @@ glm::dvec2 orient(std::vector<glm::dvec2>& uv) {
     return size;
 }
 
+// True if two triangles of a flattened chart overlap (interiors meet by more
+// than a 1e-7 fraction of the chart's size; neighbours only touch). A
+// uniform grid over the chart limits the pairs tested.
+bool selfOverlaps(const std::vector<glm::dvec2>& uv, const std::vector<uint32_t>& tri) {
+    const size_t m = tri.size() / 3;
+    if (m < 2) return false;
+    glm::dvec2 lo(INFINITY), hi(-INFINITY);
+    for (const glm::dvec2& p : uv) lo = glm::min(lo, p), hi = glm::max(hi, p);
+    const glm::dvec2 size = hi - lo;
+    const double eps = 1e-7 * std::max(size.x, size.y);
+    const int g = std::clamp(int(std::sqrt(double(m))), 1, 512);
+    const glm::dvec2 cell = glm::max(size / double(g), glm::dvec2(1e-300));
+    auto cellOf = [&](const glm::dvec2& p) {
+        return glm::clamp(glm::ivec2((p - lo) / cell), glm::ivec2(0), glm::ivec2(g - 1));
+    };
+    std::vector<glm::ivec4> box(m);  // cell range per triangle
+    std::vector<uint32_t> first(size_t(g) * size_t(g) + 1, 0);
+    for (size_t t = 0; t < m; ++t) {
+        const glm::dvec2 &a = uv[tri[3 * t]], &b = uv[tri[3 * t + 1]], &c = uv[tri[3 * t + 2]];
+        const glm::ivec2 c0 = cellOf(glm::min(a, glm::min(b, c))), c1 = cellOf(glm::max(a, glm::max(b, c)));
+        box[t] = glm::ivec4(c0, c1);
+        for (int y = c0.y; y <= c1.y; ++y)
+            for (int x = c0.x; x <= c1.x; ++x) ++first[size_t(y) * size_t(g) + size_t(x) + 1];
+    }
+    for (size_t i = 1; i < first.size(); ++i) first[i] += first[i - 1];
+    std::vector<uint32_t> cursor(first.begin(), first.end() - 1), items(first.back());
+    for (size_t t = 0; t < m; ++t)
+        for (int y = box[t].y; y <= box[t].w; ++y)
+            for (int x = box[t].x; x <= box[t].z; ++x) items[cursor[size_t(y) * size_t(g) + size_t(x)]++] = uint32_t(t);
+    auto separated = [&](size_t a, size_t b) {
+        const glm::dvec2 pa[3] = {uv[tri[3 * a]], uv[tri[3 * a + 1]], uv[tri[3 * a + 2]]};
+        const glm::dvec2 pb[3] = {uv[tri[3 * b]], uv[tri[3 * b + 1]], uv[tri[3 * b + 2]]};
+        for (int side = 0; side < 2; ++side) {
+            const glm::dvec2* p = side == 0 ? pa : pb;
+            for (int k = 0; k < 3; ++k) {
+                const glm::dvec2 e = p[(k + 1) % 3] - p[k];
+                const double len = glm::length(e);
+                if (!(len > 0.0)) continue;
+                const glm::dvec2 axis(-e.y / len, e.x / len);
+                double minA = INFINITY, maxA = -INFINITY, minB = INFINITY, maxB = -INFINITY;
+                for (int j = 0; j < 3; ++j) {
+                    const double da = glm::dot(pa[j], axis), db = glm::dot(pb[j], axis);
+                    minA = std::min(minA, da), maxA = std::max(maxA, da);
+                    minB = std::min(minB, db), maxB = std::max(maxB, db);
+                }
+                if (maxA <= minB + eps || maxB <= minA + eps) return true;
+            }
+        }
+        return false;
+    };
+    for (size_t c = 0; c + 1 < first.size(); ++c)
+        for (uint32_t i = first[c]; i < first[c + 1]; ++i)
+            for (uint32_t j = i + 1; j < first[c + 1]; ++j)
+                if (!separated(items[i], items[j])) return true;
+    return false;
+}
+
 struct ChartShape {
     glm::dvec2 extent{0.0};
     double area = 0.0;
@@ -418,49 +473,72 @@ ChartShape flattenChart(const Topology& topo, const std::vector<uint32_t>& trian
 MeshCharts makeCharts(Mesh& mesh, const glm::dmat3& metricFromObject, const UvChartOptions& options) {
     const Topology topo = buildTopology(mesh, metricFromObject);
     const size_t nt = topo.triangleCount();
-    size_t chartCount = 0;
-    const std::vector<int32_t> chartOf = growCharts(topo, options, chartCount);
+    const double cosHard = std::cos(double(options.hardAngleDegrees) * PI / 180.0);
+    const double cone = double(options.coneAngleDegrees) * PI / 180.0;
+    const size_t maxTriangles = size_t(std::max(1, options.maxChartTriangles));
+    std::vector<int32_t> mark(nt, -1);
+    std::vector<uint32_t> all(nt);
+    std::iota(all.begin(), all.end(), 0u);
 
-    // triangles by chart (counting sort keeps each chart's in mesh order)
-    std::vector<uint32_t> first(chartCount + 1, 0), byChart(nt);
-    for (size_t t = 0; t < nt; ++t) ++first[size_t(chartOf[t]) + 1];
-    for (size_t c = 0; c < chartCount; ++c) first[c + 1] += first[c];
-    {
-        std::vector<uint32_t> cursor(first.begin(), first.end() - 1);
-        for (size_t t = 0; t < nt; ++t) byChart[cursor[size_t(chartOf[t])]++] = uint32_t(t);
-    }
+    // charts to flatten; one that folds over itself (or flips a triangle) is
+    // grown again inside with half the cone, or half the size when that does
+    // not cut it, and its parts queued
+    struct Work {
+        std::vector<uint32_t> triangles;
+        double cone;
+        size_t maxTriangles;
+    };
+    std::vector<Work> work;
+    for (auto& c : growCharts(topo, all, mark, cosHard, std::cos(cone), maxTriangles))
+        work.push_back({std::move(c), cone, maxTriangles});
 
     MeshCharts charts;
-    charts.extent.resize(chartCount);
-    charts.area.resize(chartCount);
-    charts.stretch.resize(chartCount);
-    charts.lscm.resize(chartCount);
+    std::vector<int32_t> chartOf(nt, -1);
     std::vector<glm::dvec2> cornerUv(3 * nt);
     std::vector<int32_t> localOf(topo.point.size(), -1);
-    std::vector<uint32_t> local, tri, triangles;
+    std::vector<uint32_t> local, tri;
     std::vector<glm::dvec2> uv;
-    for (size_t c = 0; c < chartCount; ++c) {
-        triangles.assign(byChart.begin() + first[c], byChart.begin() + first[c + 1]);
+    for (size_t w = 0; w < work.size(); ++w) {
+        const std::vector<uint32_t> triangles = std::move(work[w].triangles);
         local.clear();
         tri.clear();
         for (uint32_t t : triangles)
             for (int k = 0; k < 3; ++k) {
-                const uint32_t w = topo.corner[3 * size_t(t) + size_t(k)];
-                if (localOf[w] < 0) {
-                    localOf[w] = int32_t(local.size());
-                    local.push_back(w);
+                const uint32_t v = topo.corner[3 * size_t(t) + size_t(k)];
+                if (localOf[v] < 0) {
+                    localOf[v] = int32_t(local.size());
+                    local.push_back(v);
                 }
-                tri.push_back(uint32_t(localOf[w]));
+                tri.push_back(uint32_t(localOf[v]));
             }
+        for (uint32_t v : local) localOf[v] = -1;
         const ChartShape shape = flattenChart(topo, triangles, local, tri, uv);
-        charts.extent[c] = shape.extent;
-        charts.area[c] = shape.area;
-        charts.stretch[c] = shape.stretch;
-        charts.lscm[c] = shape.lscm ? 1 : 0;
-        for (size_t i = 0; i < triangles.size(); ++i)
+        if (triangles.size() > 1 && (!std::isfinite(shape.stretch) || selfOverlaps(uv, tri))) {
+            for (uint32_t t : triangles) mark[t] = -1;
+            double subCone = 0.5 * work[w].cone;
+            size_t subMax = work[w].maxTriangles;
+            auto parts = growCharts(topo, triangles, mark, cosHard, std::cos(subCone), subMax);
+            if (parts.size() < 2) {
+                for (uint32_t t : triangles) mark[t] = -1;
+                subCone = work[w].cone;
+                subMax = (triangles.size() + 1) / 2;
+                parts = growCharts(topo, triangles, mark, cosHard, std::cos(subCone), subMax);
+            }
+            ++charts.splitCharts;
+            for (auto& part : parts) work.push_back({std::move(part), subCone, subMax});
+            continue;
+        }
+        const uint32_t c = uint32_t(charts.extent.size());
+        charts.extent.push_back(shape.extent);
+        charts.area.push_back(shape.area);
+        charts.stretch.push_back(shape.stretch);
+        charts.lscm.push_back(shape.lscm ? 1 : 0);
+        for (size_t i = 0; i < triangles.size(); ++i) {
+            chartOf[triangles[i]] = int32_t(c);
             for (int k = 0; k < 3; ++k) cornerUv[3 * size_t(triangles[i]) + size_t(k)] = uv[tri[3 * i + size_t(k)]];
-        for (uint32_t w : local) localOf[w] = -1;
+        }
     }
+    const size_t chartCount = charts.extent.size();
 
     charts.packOrder.resize(chartCount);
     std::iota(charts.packOrder.begin(), charts.packOrder.end(), 0u);
@@ -592,7 +670,8 @@ GridCoverage gridCoverage(const Mesh& mesh, int width, int height) {
                 for (int x = x0; x <= x1; ++x) {
                     const glm::dvec2 c(x + 0.5, y + 0.5);
                     bool inside = true;
-                    for (int k = 0; k < 3 && inside; ++k) inside = sign * cross2(p[(k + 1) % 3] - p[k], c - p[k]) > 0.0;
+                    for (int k = 0; k < 3 && inside; ++k)
+                        inside = sign * cross2(p[(k + 1) % 3] - p[k], c - p[k]) > 1e-4 * glm::length(p[(k + 1) % 3] - p[k]);
                     if (!inside) continue;
                     uint8_t& n = count[size_t(y) * size_t(width) + size_t(x)];
                     if (n == 0) ++out.covered;

@@ -52,6 +52,7 @@ struct MeshCharts {
     std::vector<double> stretch;       // per chart: L2 stretch (Sander et al. 2001) after scaling to equal area; 1 = isometric
     std::vector<uint8_t> lscm;         // per chart: 1 if flattened by LSCM, 0 by planar projection
     std::vector<uint32_t> packOrder;   // charts by decreasing height (then width, index): packCharts' order
+    size_t splitCharts = 0;            // charts cut again because their flattening folded over itself
     // per primitive of the mesh, per (split) vertex
     std::vector<std::vector<uint32_t>> vertexChart;
     std::vector<std::vector<glm::vec2>> vertexPoint;
@@ -85,7 +86,7 @@ void writeUv1(Mesh& mesh, const MeshCharts& charts, const ChartPacking& packing)
 
 // Texel centres of a width x height grid inside the TEXCOORD_1 triangles of
 // `mesh` (uv1 * grid; a centre on a shared edge counts for neither side), and
-// those inside two or more.
+// those inside two or more. Centres within 1e-4 texel of an edge count as on it.
 struct GridCoverage {
     size_t covered = 0;
     size_t overlapping = 0;
