@@ -710,6 +710,12 @@ Expected<Layout> computeLayout(Scene& scene, const LayoutOptions& options) {
     if (st.overlappingTexels > 0)
         logWarning(std::to_string(st.overlappingTexels) + " texel(s) of the generated light map UVs lie in two "
                    "triangles (overlapping charts)");
+    if (st.charts > 0 && 2 * st.subTexelCharts > st.charts)
+        logWarning(std::to_string(st.subTexelCharts) + " of the " + std::to_string(st.charts) +
+                   " generated light map charts are smaller than a texel at " +
+                   std::to_string(layout->texelDensity) +
+                   " texels per scene unit; they share the light of their neighbours. Raise --resolution or "
+                   "--texel-density");
     char line[256];
     std::snprintf(line, sizeof line,
                   "generated light map UVs for %zu mesh(es): %zu charts (%zu by LSCM), worst stretch %.3f, "

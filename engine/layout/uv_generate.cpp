@@ -164,16 +164,17 @@ Topology buildTopology(const Mesh& mesh, const glm::dmat3& metricFromObject) {
 // Charts grown breadth-first from the largest available triangle among
 // `candidates` (mark -1; growing sets mark to >= 0): a neighbour joins while
 // its normal is within the hard angle of the triangle it is reached from and
-// within the cone of the seed's normal, up to maxTriangles.
+// within the cone of the seed's normal, up to maxTriangles. Chart c's
+// triangles get mark base + c (bases differ between calls: marks stay unique).
 std::vector<std::vector<uint32_t>> growCharts(const Topology& topo, std::vector<uint32_t> candidates,
                                               std::vector<int32_t>& mark, double cosHard, double cosCone,
-                                              size_t maxTriangles) {
+                                              size_t maxTriangles, int32_t base, std::vector<uint32_t>* seeds) {
     std::stable_sort(candidates.begin(), candidates.end(),
                      [&](uint32_t a, uint32_t b) { return topo.area[a] > topo.area[b]; });
     std::vector<std::vector<uint32_t>> charts;
     for (uint32_t seed : candidates) {
         if (mark[seed] >= 0) continue;
-        const int32_t c = int32_t(charts.size());
+        const int32_t c = base + int32_t(charts.size());
         const glm::dvec3 n0 = topo.normal[seed];
         std::vector<uint32_t> queue(1, seed);
         mark[seed] = c;
@@ -190,8 +191,55 @@ std::vector<std::vector<uint32_t>> growCharts(const Topology& topo, std::vector<
         }
         std::sort(queue.begin(), queue.end());  // mesh order
         charts.push_back(std::move(queue));
+        if (seeds) seeds->push_back(seed);
     }
     return charts;
+}
+
+// Growing leaves slivers of triangles between charts (outside one chart's
+// cone, too few for their own): from the smallest up, a chart joins the
+// neighbour (no smaller) it shares the most soft edges with, if that
+// neighbour's seed cone holds all its triangles. `mark`: base + chart per
+// triangle (as growCharts left them; other marks are other calls' charts).
+void mergeSmallCharts(const Topology& topo, std::vector<std::vector<uint32_t>>& charts,
+                      const std::vector<uint32_t>& seeds, std::vector<int32_t>& mark, double cosHard, double cosCone,
+                      size_t maxTriangles, int32_t base) {
+    std::vector<uint32_t> order(charts.size());
+    std::iota(order.begin(), order.end(), 0u);
+    std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return charts[a].size() < charts[b].size(); });
+    std::vector<uint32_t> shared(charts.size(), 0);
+    std::vector<uint32_t> touched;
+    for (uint32_t c : order) {
+        if (charts[c].empty()) continue;
+        touched.clear();
+        for (uint32_t t : charts[c])
+            for (int k = 0; k < 3; ++k) {
+                const int32_t u = topo.neighbour[3 * size_t(t) + size_t(k)];
+                if (u < 0) continue;
+                const int64_t m = int64_t(mark[size_t(u)]) - base;
+                if (m < 0 || m >= int64_t(charts.size())) continue;
+                const uint32_t d = uint32_t(m);
+                if (d == c || glm::dot(topo.normal[t], topo.normal[size_t(u)]) < cosHard) continue;
+                if (shared[d]++ == 0) touched.push_back(d);
+            }
+        uint32_t best = c, bestShared = 0;
+        for (uint32_t d : touched) {
+            if (charts[d].size() >= charts[c].size() && charts[d].size() + charts[c].size() <= maxTriangles &&
+                (shared[d] > bestShared || (shared[d] == bestShared && d < best))) {
+                bool inCone = true;
+                const glm::dvec3 n0 = topo.normal[seeds[d]];
+                for (uint32_t t : charts[c]) inCone = inCone && glm::dot(topo.normal[t], n0) >= cosCone;
+                if (inCone) best = d, bestShared = shared[d];
+            }
+        }
+        for (uint32_t d : touched) shared[d] = 0;
+        if (best == c) continue;
+        for (uint32_t t : charts[c]) mark[t] = base + int32_t(best);
+        charts[best].insert(charts[best].end(), charts[c].begin(), charts[c].end());
+        std::sort(charts[best].begin(), charts[best].end());
+        charts[c].clear();
+    }
+    charts.erase(std::remove_if(charts.begin(), charts.end(), [](const auto& c) { return c.empty(); }), charts.end());
 }
 
 double cross2(const glm::dvec2& a, const glm::dvec2& b) { return a.x * b.y - a.y * b.x; }
@@ -422,7 +470,7 @@ struct ChartShape {
 // Flattens one chart: `local` are its welded vertices, `tri` its triangles
 // as local indices; fills `uv` (per local vertex).
 ChartShape flattenChart(const Topology& topo, const std::vector<uint32_t>& triangles, const std::vector<uint32_t>& local,
-                        const std::vector<uint32_t>& tri, std::vector<glm::dvec2>& uv) {
+                        const std::vector<uint32_t>& tri, std::vector<glm::dvec2>& uv, bool allowLscm) {
     ChartShape shape;
     glm::dvec3 mean(0.0);
     for (uint32_t t : triangles) {
@@ -445,7 +493,7 @@ ChartShape flattenChart(const Topology& topo, const std::vector<uint32_t>& trian
         uv[i] = glm::dvec2(glm::dot(q[i], e1), glm::dot(q[i], e2));
     }
     shape.stretch = l2Stretch(q, uv, tri);
-    if (minCos < FLAT_COS) {
+    if (allowLscm && minCos < FLAT_COS) {
         std::vector<glm::dvec2> conformal = uv;
         if (solveLscm(q, tri, conformal)) {
             const double s = l2Stretch(q, conformal, tri);
@@ -489,8 +537,14 @@ MeshCharts makeCharts(Mesh& mesh, const glm::dmat3& metricFromObject, const UvCh
         size_t maxTriangles;
     };
     std::vector<Work> work;
-    for (auto& c : growCharts(topo, all, mark, cosHard, std::cos(cone), maxTriangles))
-        work.push_back({std::move(c), cone, maxTriangles});
+    int32_t nextMark = 0;  // the next chart mark (unique over every growCharts call)
+    {
+        std::vector<uint32_t> seeds;
+        auto grown = growCharts(topo, all, mark, cosHard, std::cos(cone), maxTriangles, 0, &seeds);
+        nextMark = int32_t(grown.size());
+        mergeSmallCharts(topo, grown, seeds, mark, cosHard, std::cos(cone), maxTriangles, 0);
+        for (auto& c : grown) work.push_back({std::move(c), cone, maxTriangles});
+    }
 
     MeshCharts charts;
     std::vector<int32_t> chartOf(nt, -1);
@@ -512,18 +566,31 @@ MeshCharts makeCharts(Mesh& mesh, const glm::dmat3& metricFromObject, const UvCh
                 tri.push_back(uint32_t(localOf[v]));
             }
         for (uint32_t v : local) localOf[v] = -1;
-        const ChartShape shape = flattenChart(topo, triangles, local, tri, uv);
-        if (triangles.size() > 1 && (!std::isfinite(shape.stretch) || selfOverlaps(uv, tri))) {
+        ChartShape shape = flattenChart(topo, triangles, local, tri, uv, true);
+        bool folded = triangles.size() > 1 && (!std::isfinite(shape.stretch) || selfOverlaps(uv, tri));
+        if (folded && shape.lscm) {
+            // LSCM's free boundary may cross itself; the projection may not
+            shape = flattenChart(topo, triangles, local, tri, uv, false);
+            folded = !std::isfinite(shape.stretch) || selfOverlaps(uv, tri);
+        }
+        if (folded) {
             for (uint32_t t : triangles) mark[t] = -1;
             double subCone = 0.5 * work[w].cone;
             size_t subMax = work[w].maxTriangles;
-            auto parts = growCharts(topo, triangles, mark, cosHard, std::cos(subCone), subMax);
+            std::vector<uint32_t> seeds;
+            int32_t base = nextMark;
+            auto parts = growCharts(topo, triangles, mark, cosHard, std::cos(subCone), subMax, base, &seeds);
+            nextMark += int32_t(parts.size());
             if (parts.size() < 2) {
                 for (uint32_t t : triangles) mark[t] = -1;
                 subCone = work[w].cone;
                 subMax = (triangles.size() + 1) / 2;
-                parts = growCharts(topo, triangles, mark, cosHard, std::cos(subCone), subMax);
+                seeds.clear();
+                base = nextMark;
+                parts = growCharts(topo, triangles, mark, cosHard, std::cos(subCone), subMax, base, &seeds);
+                nextMark += int32_t(parts.size());
             }
+            mergeSmallCharts(topo, parts, seeds, mark, cosHard, std::cos(subCone), subMax, base);
             ++charts.splitCharts;
             for (auto& part : parts) work.push_back({std::move(part), subCone, subMax});
             continue;
@@ -606,8 +673,8 @@ ChartPacking packCharts(const MeshCharts& charts, double texelsPerUnit, int gap)
     double paddedArea = 0.0;
     int widest = 1;
     for (size_t c = 0; c < n; ++c) {
-        // the chart plus at least half a texel on each side
-        const glm::dvec2 texels = charts.extent[c] * texelsPerUnit + 1.0;
+        // whole texels around the chart (>= 1 each way)
+        const glm::dvec2 texels = charts.extent[c] * texelsPerUnit;
         const glm::ivec2 s(int(std::min(std::ceil(texels.x - 1e-9), 1e8)), int(std::min(std::ceil(texels.y - 1e-9), 1e8)));
         pack.size[c] = glm::max(s, glm::ivec2(1));
         paddedArea += double(pack.size[c].x + gap) * double(pack.size[c].y + gap);

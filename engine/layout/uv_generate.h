@@ -8,10 +8,11 @@
 //                split the vertices so that every vertex lies in one chart.
 //                Costs about 1 s per million triangles on one core.
 //   packCharts   place the charts' rectangles on an integer texel grid at a
-//                given texel density, `gap` free texels between rectangles,
-//                each chart centred in its rectangle with >= half a texel free
-//                on every side. O(charts); called many times by the automatic
-//                density search.
+//                given texel density, `gap` free texels between rectangles
+//                (texel centres of two charts are gap + 1 texels apart or
+//                more), each chart centred in the whole texels around it (a
+//                chart of whole texels fills them exactly). O(charts); called
+//                many times by the automatic density search.
 //   writeUv1     TEXCOORD_1 = texel position / grid size, and Mesh::uv1Grid.
 //
 // Units: charts are cut and measured in "metric" space, the mesh's object
@@ -73,8 +74,8 @@ struct ChartPacking {
     double texelsPerUnit = 0.0;
 };
 
-// Packs the charts' rectangles (ceil(extent * texelsPerUnit + 1) texels each
-// way) by shelves, tallest first, into a grid about as wide as tall, with
+// Packs the charts' rectangles (max(1, ceil(extent * texelsPerUnit)) texels
+// each way) by shelves, tallest first, into a grid about as wide as tall, with
 // `gap` (>= 0) free texels between rectangles (none around the grid: the pack
 // layout's padding is outside it). texelsPerUnit >= 0.
 ChartPacking packCharts(const MeshCharts& charts, double texelsPerUnit, int gap);
