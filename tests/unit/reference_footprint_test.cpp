@@ -2,15 +2,16 @@
 // chart (issue 11), right at every light map resolution. No GL.
 //
 // - The rho 0.9 furnace (assets/furnace/furnace_rho09.gltf: Le 1 everywhere,
-//   sealed) at 16^2, 32^2, 64^2 and 256^2 in the pack, asset and generate
-//   layouts. Two estimators:
+//   sealed) at 16^2, 32^2, 64^2 and 256^2, with chart borders through texel
+//   centres and in the pack, asset and generate layouts. Two estimators:
 //   * exact: emitter sampling off, no roulette, N path vertices. In a sealed
 //     furnace every path then returns exactly sum_{k<N} rho^k =
 //     (1 - rho^N) / (1 - rho) (ANALYTIC_REFERENCES 1.1, the bounce-count
 //     form), so a texel off it has lost paths through the surface: a geometric
-//     error, not noise. The generate layout puts chart borders through texel
-//     centres; before footprints and the edge inset a point on a border started
-//     half its rays outside the box (64^2: -5.8 % mean, p99 53 %, max 73 %).
+//     error, not noise. Where a chart border runs through texel centres,
+//     before footprints and the edge inset, a texel's point lay on the box's
+//     edge and started about half its rays behind the other wall (figures at
+//     the tests).
 //   * the default (next-event estimation + MIS, roulette from the third
 //     vertex): unbiased, L_lm = Le / (1 - rho) = 10; its mean over the texels,
 //     at an spp that puts the mean's standard deviation near 0.1 %.
@@ -41,6 +42,7 @@ std::string assetPath(const std::string& relative) { return std::string(BUNDLEBA
 
 const char* layoutName(UvLayout mode) {
     return mode == UvLayout::Asset ? "asset" : mode == UvLayout::Pack ? "pack" : "generate";
+
 }
 
 struct FurnaceError {
@@ -51,14 +53,53 @@ struct FurnaceError {
     double worst = 0.0;
 };
 
-// Bakes the furnace at `resolution` in `mode` and measures the covered texels against `expected`.
-FurnaceError bakeFurnace(UvLayout mode, int resolution, const ReferenceOptions& options, double expected) {
+struct LayoutCase {
+    UvLayout mode;
+    float texelDensity = 0.0f;  // 0: fit the page (pack, generate)
+    bool bordersThroughCentres = false;  // asset: TEXCOORD_1 remade by bordersThroughCentres()
+};
+
+const char* caseName(const LayoutCase& c) {
+    return c.bordersThroughCentres ? "borders" : layoutName(c.mode);
+}
+
+// The furnace's 12 faces (4 vertices each in the file) as charts whose borders
+// run through texel centres at `resolution`: face f spans
+// [c + 0.5, c + 0.5 + w] texels in u and v, c its cell's corner in a 4 x 3 grid
+// of cells of resolution/4 texels, w = resolution/4 - 2. A point-sampled texel
+// on a border lies on the box's edge, where two walls meet.
+void bordersThroughCentres(Scene& scene, int resolution) {
+    const double cell = resolution / 4.0, w = cell - 2.0;
+    int face = 0;
+    for (Mesh& mesh : scene.meshes)
+        for (Primitive& p : mesh.primitives) {
+            ASSERT_EQ(p.uv1.size(), 24u) << "the furnace's boxes: 6 faces of 4 vertices";
+            for (size_t first = 0; first < p.uv1.size(); first += 4, ++face) {
+                glm::vec2 lo(1e9f), hi(-1e9f);
+                for (size_t k = first; k < first + 4; ++k) {
+                    lo = glm::min(lo, p.uv1[k]);
+                    hi = glm::max(hi, p.uv1[k]);
+                }
+                const glm::dvec2 corner(cell * (face % 4) + 0.5, cell * (face / 4) + 0.5);
+                for (size_t k = first; k < first + 4; ++k) {
+                    const glm::dvec2 t = glm::dvec2(p.uv1[k] - lo) / glm::dvec2(hi - lo);  // 0 or 1
+                    p.uv1[k] = glm::vec2((corner + glm::round(t) * w) / double(resolution));
+                }
+            }
+        }
+    ASSERT_EQ(face, 12);
+}
+
+// Bakes the furnace at `resolution` in `layout` and measures the covered texels against `expected`.
+FurnaceError bakeFurnace(LayoutCase layoutCase, int resolution, const ReferenceOptions& options, double expected) {
     auto scene = loadScene(assetPath("furnace/furnace_rho09.gltf"));
     EXPECT_TRUE(scene) << scene.error();
     if (!scene) return {};
+    if (layoutCase.bordersThroughCentres) bordersThroughCentres(*scene, resolution);
     LayoutOptions lo;
-    lo.mode = mode;
+    lo.mode = layoutCase.mode;
     lo.resolution = resolution;
+    lo.texelDensity = layoutCase.texelDensity;
     auto layout = computeLayout(*scene, lo);  // generates TEXCOORD_1 in the generate layout
     EXPECT_TRUE(layout) << layout.error();
     if (!layout) return {};
@@ -91,7 +132,7 @@ FurnaceError bakeFurnace(UvLayout mode, int resolution, const ReferenceOptions& 
 }
 
 // The exact estimator (see the top): every layout that covers texels at this resolution.
-void checkExact(int resolution, int spp, std::vector<UvLayout> modes) {
+void checkExact(int resolution, int spp, std::vector<LayoutCase> cases) {
     const int vertices = 32;
     ReferenceOptions o;
     o.spp = spp;
@@ -100,14 +141,14 @@ void checkExact(int resolution, int spp, std::vector<UvLayout> modes) {
     o.rouletteDepth = vertices;
     o.maxBounces = vertices;
     const double expected = (1.0 - std::pow(RHO, vertices)) / (1.0 - RHO);  // 9.6566
-    for (UvLayout mode : modes) {
-        const FurnaceError r = bakeFurnace(mode, resolution, o, expected);
-        std::printf("[furnace exact] %3d^2 %-8s %6d texels, %d spp: mean %+.4f %%, p99 %.4f %%, worst %.4f %%\n",
-                    resolution, layoutName(mode), r.texels, spp, 100.0 * (r.mean / expected - 1.0), 100.0 * r.p99,
-                    100.0 * r.worst);
-        EXPECT_GT(r.texels, 0) << layoutName(mode);
-        EXPECT_LT(r.meanError, 0.005) << layoutName(mode) << " at " << resolution;
-        EXPECT_LT(r.p99, 0.005) << layoutName(mode) << " at " << resolution;
+    for (const LayoutCase& c : cases) {
+        const FurnaceError r = bakeFurnace(c, resolution, o, expected);
+        std::printf("[furnace exact] %3d^2 %-8s density %4.1f %6d texels, %d spp: mean %+.4f %%, p99 %.4f %%, worst %.4f %%\n",
+                    resolution, caseName(c), c.texelDensity, r.texels, spp, 100.0 * (r.mean / expected - 1.0),
+                    100.0 * r.p99, 100.0 * r.worst);
+        EXPECT_GT(r.texels, 0) << caseName(c);
+        EXPECT_LT(r.meanError, 0.005) << caseName(c) << " at " << resolution;
+        EXPECT_LT(r.p99, 0.005) << caseName(c) << " at " << resolution;
     }
 }
 
@@ -118,7 +159,7 @@ void checkDefault(int resolution, int spp) {
     ReferenceOptions o;
     o.spp = spp;
     o.passSpp = spp;
-    const FurnaceError r = bakeFurnace(UvLayout::Asset, resolution, o, 1.0 / (1.0 - RHO));
+    const FurnaceError r = bakeFurnace({UvLayout::Asset}, resolution, o, 1.0 / (1.0 - RHO));
     std::printf("[furnace default] %3d^2 asset %6d texels, %d spp: mean %+.4f %% (sd of the mean ~%.3f %%), p99 %.2f %%\n",
                 resolution, r.texels, spp, 100.0 * (r.mean / 10.0 - 1.0),
                 2.9 * std::sqrt(1024.0 / spp) / std::sqrt(std::max(1, r.texels)), 100.0 * r.p99);
@@ -126,25 +167,29 @@ void checkDefault(int resolution, int spp) {
     EXPECT_LT(r.meanError, 0.005) << "at " << resolution;
 }
 
+// "borders": chart borders through texel centres (bordersThroughCentres), the
+// case that failed: before footprints and the inset the reference read there
+// (exact estimator) 21 % low at 16^2 (p99 72 %), 7.9 % at 32^2 (p99 67 %),
+// 3.5 % at 64^2 (p99 50 %), 0.8 % at 256^2 (p99 50 %): the share of texels
+// on borders. The layouts as they come (pack, asset, generate) are measured too.
 TEST(ReferenceFootprint, FurnaceRho09At16) {
-    // generate covers no texel centre at 16^2 (its charts are under a texel): not measured
-    checkExact(16, 64, {UvLayout::Pack, UvLayout::Asset});
+    // generate at its own density covers no texel centre at 16^2 (its charts are under a texel)
+    checkExact(16, 64, {{UvLayout::Asset, 0.0f, true}, {UvLayout::Pack}, {UvLayout::Asset}, {UvLayout::Generate, 3.0f}});
     checkDefault(16, 4096);
 }
 
 TEST(ReferenceFootprint, FurnaceRho09At32) {
-    checkExact(32, 64, {UvLayout::Pack, UvLayout::Asset, UvLayout::Generate});
+    checkExact(32, 64, {{UvLayout::Asset, 0.0f, true}, {UvLayout::Pack}, {UvLayout::Asset}, {UvLayout::Generate}});
     checkDefault(32, 1024);
 }
 
 TEST(ReferenceFootprint, FurnaceRho09At64) {
-    checkExact(64, 16, {UvLayout::Pack, UvLayout::Asset, UvLayout::Generate});
+    checkExact(64, 16, {{UvLayout::Asset, 0.0f, true}, {UvLayout::Pack}, {UvLayout::Asset}, {UvLayout::Generate}});
     checkDefault(64, 256);
 }
 
 TEST(ReferenceFootprint, FurnaceRho09At256) {
-    // generate: charts on half-texel offsets, borders through texel centres
-    checkExact(256, 4, {UvLayout::Generate});
+    checkExact(256, 4, {{UvLayout::Asset, 0.0f, true}});
     checkDefault(256, 16);
 }
 
