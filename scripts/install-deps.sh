@@ -30,3 +30,18 @@ if [ -n "$missing" ]; then
 else
     echo "install-deps: all packages present"
 fi
+
+# The Khronos glTF-Validator for the export tests (tests/validator, npm
+# package gltf-validator at the version pinned in its package.json), unless
+# it is there. npm comes with Debian's nodejs and npm packages when absent.
+VALIDATOR_DIR="$(cd "$(dirname "$0")/.." && pwd)/tests/validator"
+if [ ! -f "$VALIDATOR_DIR/node_modules/gltf-validator/package.json" ]; then
+    if ! command -v npm >/dev/null 2>&1; then
+        echo "install-deps: installing: nodejs npm"
+        export DEBIAN_FRONTEND=noninteractive
+        apt-get update -q
+        apt-get install -y -q --no-install-recommends nodejs npm
+    fi
+    echo "install-deps: installing gltf-validator into tests/validator"
+    (cd "$VALIDATOR_DIR" && npm ci --no-audit --no-fund --loglevel=error)
+fi

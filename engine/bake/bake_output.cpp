@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 
 #include "io/image_io.h"
 
@@ -26,7 +27,82 @@ float autoExposure(const LightmapPages& maps) {
     return *q > 0.0f ? std::log2(0.6f / *q) : 0.0f;
 }
 
+// The layout request that recomputes `layout`: its mode, resolution and
+// padding, and the requested density from the run's flags
+// (BakeOutputInfo::settings "texel_density", as bake, reference and the viewer
+// echo it; 0 = auto), else the density the layout used.
+nlohmann::json layoutRequest(const Layout& layout, const nlohmann::json& settings) {
+    const char* mode = layoutModeName(layout.mode);
+    double density = layout.mode == UvLayout::Asset ? 0.0 : double(layout.texelDensity);
+    if (settings.is_object() && settings.contains("texel_density") && settings["texel_density"].is_number())
+        density = settings["texel_density"].get<double>();
+    const UvChartOptions charts;  // not a flag: always the defaults
+    return {{"uv_layout", mode},
+            {"resolution", layout.resolution},
+            {"texel_density", density},
+            {"padding_texels", layout.padding},
+            {"uv_charts",
+             {{"hard_angle_degrees", charts.hardAngleDegrees},
+              {"cone_angle_degrees", charts.coneAngleDegrees},
+              {"max_chart_triangles", charts.maxChartTriangles}}}};
+}
+
 }  // namespace
+
+const char* layoutModeName(UvLayout mode) {
+    return mode == UvLayout::Asset ? "asset" : mode == UvLayout::Generate ? "generate" : "pack";
+}
+
+Expected<BakeManifest> readBakeManifest(const std::string& dir) {
+    using Fail = Expected<BakeManifest>;
+    const std::string path = dir + "/manifest.json";
+    std::ifstream file(path);
+    if (!file) return Fail::failure("cannot read " + path + ": not a bundlebake light map directory");
+    nlohmann::json m;
+    try {
+        file >> m;
+    } catch (const nlohmann::json::exception&) {
+        return Fail::failure(path + ": not valid JSON");
+    }
+    try {
+        BakeManifest out;
+        out.scene = m.value("scene", std::string());
+        out.generator = m.value("generator", std::string());
+        out.pageCount = int(m.at("pages").size());
+        out.instanceCount = m.at("instances").size();
+        auto modeOf = [&](const std::string& name) -> Expected<UvLayout> {
+            if (name == "asset") return UvLayout::Asset;
+            if (name == "pack") return UvLayout::Pack;
+            if (name == "generate") return UvLayout::Generate;
+            return Expected<UvLayout>::failure(path + ": unknown layout '" + name + "'");
+        };
+        if (m.contains("layout_options")) {
+            const auto& o = m.at("layout_options");
+            auto mode = modeOf(o.at("uv_layout").get<std::string>());
+            if (!mode) return mode.status();
+            out.layout.mode = *mode;
+            out.layout.resolution = o.at("resolution").get<int>();
+            out.layout.texelDensity = o.at("texel_density").get<float>();
+            out.layout.padding = o.at("padding_texels").get<int>();
+            if (o.contains("uv_charts")) {
+                const auto& c = o.at("uv_charts");
+                out.layout.charts.hardAngleDegrees = c.at("hard_angle_degrees").get<float>();
+                out.layout.charts.coneAngleDegrees = c.at("cone_angle_degrees").get<float>();
+                out.layout.charts.maxChartTriangles = c.at("max_chart_triangles").get<int>();
+            }
+            out.layoutRecorded = true;
+        } else {
+            auto mode = modeOf(m.at("layout").get<std::string>());
+            if (!mode) return mode.status();
+            out.layout.mode = *mode;
+            out.layout.resolution = m.at("resolution").get<int>();
+            out.layout.padding = m.value("padding_texels", out.layout.padding);
+        }
+        return out;
+    } catch (const nlohmann::json::exception& e) {
+        return Fail::failure(path + ": missing or malformed field (" + std::string(e.what()) + ")");
+    }
+}
 
 std::string lightmapFileName(int page, const char* extension) {
     char name[64];
@@ -82,7 +158,8 @@ Status writeBakeOutputs(const std::string& outDir, const Scene& scene, const Lay
         {"scene", scene.path},
         {"units", units},
         {"mapping", "page_uv = TEXCOORD_1 * uv1_scale + uv1_offset"},
-        {"layout", layout.mode == UvLayout::Asset ? "asset" : "pack"},
+        {"layout", layoutModeName(layout.mode)},
+        {"layout_options", layoutRequest(layout, info.settings)},
         {"resolution", layout.resolution},
         {"padding_texels", layout.padding},
         {"texel_density", layout.texelDensity},

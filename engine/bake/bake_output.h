@@ -37,4 +37,29 @@ std::string coverageFileName(int page);
 // Page file name: "lightmap_<page>.exr".
 std::string lightmapFileName(int page, const char* extension = "exr");
 
+// The layout a bake directory's manifest.json records: the request that
+// recomputes it exactly (computeLayout is deterministic, generated TEXCOORD_1
+// included), so `render`, `export` and the viewer's --open need no flags.
+// manifest.json "layout_options": {"uv_layout", "resolution", "texel_density"
+// (as requested: 0 = auto), "padding_texels", "uv_charts": {...}}; the
+// density, rectangles and pages that came out are recorded beside it.
+struct BakeManifest {
+    std::string scene;             // the scene path as the bake was given it
+    std::string generator;         // "bundlebake", "bundlebake reference"
+    LayoutOptions layout;          // mode, resolution, requested density, padding, chart options
+    // false: a manifest written before "layout_options" (mode and resolution
+    // come from its "layout" and "resolution"; a generate bake reads as pack
+    // and the requested density is unknown, so layout.texelDensity is 0).
+    bool layoutRecorded = false;
+    int pageCount = 0;
+    size_t instanceCount = 0;
+};
+
+// Reads DIR/manifest.json. Errors (one line naming the file): missing,
+// not JSON, or without the fields above.
+Expected<BakeManifest> readBakeManifest(const std::string& dir);
+
+// "asset", "pack", "generate".
+const char* layoutModeName(UvLayout mode);
+
 }  // namespace bb

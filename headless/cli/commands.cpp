@@ -26,6 +26,7 @@ int run(int argc, char** argv) {
     addRenderCommand(app, action);
     addReferenceCommand(app, action);
     addCompareCommand(app, action);
+    addExportCommand(app, action);
 
     try {
         app.parse(argc, argv);

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "bake/bake_output.h"
 #include "core/log.h"
 
 namespace bb::cli {
@@ -116,6 +117,59 @@ Expected<LoadedScene> loadSceneAndLayout(const SceneArgs& a) {
     opts.failOnOverlap = a.uvOverlap == "fail";
     opts.resolution = a.resolution;
     opts.texelDensity = a.texelDensity;
+    auto layout = computeLayout(*scene, opts);
+    if (!layout) return Expected<LoadedScene>::failure(a.scene + ": " + layout.error());
+    return LoadedScene{std::move(scene.value()), std::move(layout.value())};
+}
+
+LayoutFlagsGiven layoutFlagsGiven(const CLI::App& cmd) {
+    LayoutFlagsGiven g;
+    g.uvLayout = cmd.count("--uv-layout") > 0;
+    g.resolution = cmd.count("--resolution") > 0;
+    g.texelDensity = cmd.count("--texel-density") > 0;
+    return g;
+}
+
+Expected<LoadedScene> loadSceneWithBakeLayout(const SceneArgs& a, const LayoutFlagsGiven& given,
+                                              const std::string& bakeDir) {
+    auto manifest = readBakeManifest(bakeDir);
+    if (!manifest) return manifest.status();
+    LayoutOptions opts = manifest->layout;
+    const std::string where = " (" + bakeDir + "/manifest.json; leave the layout flags out to use the bake's)";
+    auto number = [](double v) {
+        char s[32];
+        std::snprintf(s, sizeof s, "%g", v);
+        return std::string(s);
+    };
+    if (given.uvLayout && parseUvLayout(a.uvLayout) != opts.mode) {
+        // an old manifest records a generate layout as pack: the flag decides there
+        if (manifest->layoutRecorded || !(opts.mode == UvLayout::Pack && a.uvLayout == "generate"))
+            return Expected<LoadedScene>::failure("--uv-layout " + a.uvLayout + " differs from the bake's " +
+                                                  uvLayoutName(opts.mode) + where);
+        opts.mode = UvLayout::Generate;
+    }
+    if (given.resolution && a.resolution != opts.resolution)
+        return Expected<LoadedScene>::failure("--resolution " + std::to_string(a.resolution) + " differs from the bake's " +
+                                              std::to_string(opts.resolution) + where);
+    if (given.texelDensity) {
+        if (manifest->layoutRecorded && a.texelDensity != opts.texelDensity)
+            return Expected<LoadedScene>::failure("--texel-density " + number(a.texelDensity) +
+                                                  " differs from the bake's " + number(opts.texelDensity) + where);
+        opts.texelDensity = a.texelDensity;
+    }
+    opts.failOnOverlap = false;  // the bake accepted its layout
+
+    auto albedo = parseColor(a.defaultAlbedo, "--default-albedo");
+    if (!albedo) return albedo.status();
+    LoadOptions lo;
+    lo.defaultAlbedo = *albedo;
+    auto scene = loadScene(a.scene, lo);
+    if (!scene) return scene.status();
+    if (scene->instances.size() != manifest->instanceCount)
+        return Expected<LoadedScene>::failure(a.scene + " has " + std::to_string(scene->instances.size()) +
+                                              " mesh instances, the bake in " + bakeDir + " " +
+                                              std::to_string(manifest->instanceCount) + " (the bake of " +
+                                              (manifest->scene.empty() ? "another scene" : manifest->scene) + "?)");
     auto layout = computeLayout(*scene, opts);
     if (!layout) return Expected<LoadedScene>::failure(a.scene + ": " + layout.error());
     return LoadedScene{std::move(scene.value()), std::move(layout.value())};

@@ -70,6 +70,22 @@ struct LoadedScene {
 // Generates TEXCOORD_1 where the layout needs it (see computeLayout(Scene&)).
 Expected<LoadedScene> loadSceneAndLayout(const SceneArgs& args);
 
+// The layout flags the command line gave (not their defaults): commands that
+// read a bake's manifest.json take its layout and refuse a flag that differs.
+struct LayoutFlagsGiven {
+    bool uvLayout = false, resolution = false, texelDensity = false;
+};
+// From a parsed command that has addSceneOptions (call in its callback).
+LayoutFlagsGiven layoutFlagsGiven(const CLI::App& cmd);
+
+// The scene of `args` with the layout recorded in BAKE_DIR/manifest.json
+// (bake_output.h, readBakeManifest): the same rectangles and generated
+// TEXCOORD_1 as the bake, whatever the flags' defaults. A layout flag that was
+// given and differs from the manifest is an error (one line naming both); a
+// manifest from before the layout record takes the given flags for what it lacks.
+Expected<LoadedScene> loadSceneWithBakeLayout(const SceneArgs& args, const LayoutFlagsGiven& given,
+                                              const std::string& bakeDir);
+
 // --uv-layout's names.
 UvLayout parseUvLayout(const std::string& name);
 const char* uvLayoutName(UvLayout mode);
@@ -82,6 +98,7 @@ void addImportanceCommand(CLI::App& app, std::function<int()>& action);  // impo
 void addRenderCommand(CLI::App& app, std::function<int()>& action);     // render_command.cpp
 void addReferenceCommand(CLI::App& app, std::function<int()>& action);  // reference_command.cpp
 void addCompareCommand(CLI::App& app, std::function<int()>& action);    // compare_command.cpp
+void addExportCommand(CLI::App& app, std::function<int()>& action);     // export_command.cpp
 
 int runInfo(const InfoArgs& args);
 int runBake(const BakeArgs& args);

@@ -3,8 +3,10 @@
 // renderer (engine/render/scene_renderer.h) into an sRGB PNG.
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
 #include "core/log.h"
+#include "export/gltf_export.h"
 #include "headless/cli/options.h"
 #include "headless/platform.h"
 #include "layout/bake_mesh.h"
@@ -18,7 +20,8 @@ namespace bb::cli {
 
 struct RenderArgs {
     SceneArgs scene;
-    std::string lightmapDir;
+    LayoutFlagsGiven given;
+    std::string lightmapDir;             // empty: SCENE is a `bundlebake export` file with its own light maps
     std::string output;
     std::string backend = "egl";
     int camera = -2;             // -2 = camera 0 if the scene has one, else -1 (frame the scene)
@@ -33,10 +36,12 @@ int runRender(const RenderArgs& args);
 void addRenderCommand(CLI::App& app, std::function<int()>& action) {
     auto a = std::make_shared<RenderArgs>();
     CLI::App* cmd = app.add_subcommand(
-        "render", "Render the scene with baked light maps (a `bake` OUTDIR) to a PNG; pass the bake's layout flags");
+        "render", "Render the scene with baked light maps (a `bake` OUTDIR, whose manifest.json gives the layout; or "
+                  "a .glb written by `bundlebake export` alone) to a PNG");
     addSceneOptions(*cmd, a->scene);
-    cmd->add_option("lightmaps", a->lightmapDir, "Directory written by `bundlebake bake` (manifest.json, lightmap_<p>.exr)")
-        ->required();
+    cmd->add_option("lightmaps", a->lightmapDir,
+                    "Directory written by `bundlebake bake` (manifest.json, lightmap_<p>.exr); leave it out for a "
+                    "`bundlebake export` file, which carries its light maps");
     cmd->add_option("-o,--output", a->output, "PNG to write (sRGB)")->required();
     cmd->add_option("--camera", a->camera, "glTF camera index; -1 frames the scene (default: camera 0 if any, else -1)")
         ->check(CLI::Range(-1, 1 << 20));
@@ -54,7 +59,10 @@ void addRenderCommand(CLI::App& app, std::function<int()>& action) {
     cmd->add_option("--backend", a->backend, "Headless GL: egl (surfaceless) or osmesa")
         ->check(CLI::IsMember({"egl", "osmesa"}))
         ->capture_default_str();
-    cmd->callback([a, &action] { action = [a] { return runRender(*a); }; });
+    cmd->callback([a, cmd, &action] {
+        a->given = layoutFlagsGiven(*cmd);
+        action = [a] { return runRender(*a); };
+    });
 }
 
 int runRender(const RenderArgs& args) {
@@ -70,15 +78,41 @@ int runRender(const RenderArgs& args) {
         if (end == args.exposure.c_str() || *end != '\0' || !std::isfinite(exposure) || std::abs(exposure) > 64.0f)
             return fail("--exposure: '" + args.exposure + "' is not a number of stops in [-64, 64] or auto");
     }
-    auto loaded = loadSceneAndLayout(args.scene);
-    if (!loaded) return fail(loaded.error());
+    // the layout and light maps: the bake's manifest.json, or the export's extras
+    std::optional<LoadedScene> loadedScene;
+    std::optional<LightmapPages> lightmaps;
+    std::string source = args.lightmapDir;
+    std::optional<float> recordedExposure;
+    if (!args.lightmapDir.empty()) {
+        auto loaded = loadSceneWithBakeLayout(args.scene, args.given, args.lightmapDir);
+        if (!loaded) return fail(loaded.error());
+        auto maps = readBakedLightmaps(args.lightmapDir, loaded->layout);
+        if (!maps) return fail(maps.error());
+        loadedScene = std::move(loaded.value());
+        lightmaps = std::move(maps.value());
+    } else {
+        if (args.given.uvLayout || args.given.resolution || args.given.texelDensity)
+            return fail("the layout flags apply to a bake directory; an exported file's TEXCOORD_1 is its layout");
+        auto albedo = parseColor(args.scene.defaultAlbedo, "--default-albedo");
+        if (!albedo) return fail(albedo.error());
+        LoadOptions lo;
+        lo.defaultAlbedo = *albedo;
+        auto scene = loadScene(args.scene.scene, lo);
+        if (!scene) return fail(scene.error());
+        auto exported = readExportedLightmaps(args.scene.scene, *scene);
+        if (!exported) return fail(exported.error());
+        source = args.scene.scene + " (" + exported->source + ")";
+        recordedExposure = exported->autoExposureStops;
+        loadedScene = LoadedScene{std::move(scene.value()), std::move(exported->layout)};
+        lightmaps = std::move(exported->maps);
+    }
+    const LoadedScene* loaded = &*loadedScene;
+    const LightmapPages* maps = &*lightmaps;
     const Scene& scene = loaded->scene;
     int cameraIndex = args.camera == -2 ? (scene.cameras.empty() ? -1 : 0) : args.camera;
     if (cameraIndex >= int(scene.cameras.size()))
         return fail("--camera " + std::to_string(cameraIndex) + ": the scene has " + std::to_string(scene.cameras.size()) +
                     " camera(s)" + (scene.cameras.empty() ? " (use -1 to frame the scene)" : ""));
-    auto maps = readBakedLightmaps(args.lightmapDir, loaded->layout);
-    if (!maps) return fail(maps.error());
 
     // image size: the camera's aspect ratio when the height is not given
     float cameraAspect = cameraIndex >= 0 ? scene.cameras[size_t(cameraIndex)].aspect : 0.0f;
@@ -111,14 +145,14 @@ int runRender(const RenderArgs& args) {
                                      : framingCamera(mesh.bounds, DEFAULT_FRAMING_DIRECTION, 0.8f, aspect);
     RenderSettings settings;
     settings.mode = *mode;
-    settings.exposure = autoExposed ? autoExposure(*maps) : exposure;
+    settings.exposure = !autoExposed ? exposure : recordedExposure ? *recordedExposure : autoExposure(*maps);
     Image8 image = (*renderer)->renderImage(viewFromCamera(camera, aspect, mesh.bounds), settings, width, height);
     if (Status s = writeImagePng(args.output, image); !s) return fail(s.message());
     char line[256];
-    std::snprintf(line, sizeof line, "rendered %dx%d from %s, exposure %+.2f stops (%s) -> ", width, height,
+    std::snprintf(line, sizeof line, "rendered %dx%d from %s, exposure %+.2f stops (%s), light maps of ", width, height,
                   cameraIndex >= 0 ? ("camera " + std::to_string(cameraIndex)).c_str() : "a framing camera",
                   settings.exposure, autoExposed ? "auto" : "given");
-    logInfo(line + args.output);
+    logInfo(line + source + " -> " + args.output);
     return 0;
 }
 
