@@ -4,6 +4,9 @@
 // light maps on the GPU (Baker::resolveLightmaps) and draws the scene with
 // them (engine/render/scene_renderer.h), then a Dear ImGui panel.
 //
+// --open BAKE_DIR shows a finished bake instead (its manifest.json gives the
+// layout, its EXR pages the light maps): nothing is baked.
+//
 // Scripted use: --screenshot FILE --frames N renders N frames while baking,
 // writes the scene view (without the panel) and exits 0. At exit the log
 // gives the frame time (mean, p95, max) of the frames that baked.
@@ -21,6 +24,7 @@
 #include <deque>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -69,6 +73,8 @@ struct ViewerArgs {
     bool saveAtExit = false;
     int frames = 0;
     std::string output = "viewer_out";
+    std::string open;            // a bake directory to show instead of baking
+    cli::LayoutFlagsGiven given;
 };
 
 // --- camera: orbit about a target or fly from the eye ----------------------------
@@ -160,13 +166,17 @@ std::string duration(double seconds) {
 
 class Viewer {
 public:
-    Viewer(ViewerArgs args, cli::LoadedScene loaded, BakeOptions options, std::unique_ptr<GlfwContext> context)
-        : args_(std::move(args)), loaded_(std::move(loaded)), options_(std::move(options)), context_(std::move(context)) {}
+    Viewer(ViewerArgs args, cli::LoadedScene loaded, BakeOptions options, std::unique_ptr<GlfwContext> context,
+           std::optional<LightmapPages> opened = std::nullopt)
+        : args_(std::move(args)), loaded_(std::move(loaded)), options_(std::move(options)), context_(std::move(context)),
+          opened_(std::move(opened)) {}
 
     int run();
 
 private:
     Status startBake();
+    Status showOpened();  // --open: the bake's light maps, no Baker
+    const BakeMesh& mesh() const { return baker_ ? baker_->mesh() : *openedMesh_; }
     void bakeStep();
     void handleInput(double dt);
     void drawPanel();
@@ -182,6 +192,8 @@ private:
     BakeOptions options_;
     std::unique_ptr<GlfwContext> context_;  // declared before the GL objects: destroyed after them
     std::unique_ptr<Baker> baker_;
+    std::optional<LightmapPages> opened_;  // --open: the pages read from the bake directory
+    std::optional<BakeMesh> openedMesh_;
     std::unique_ptr<SceneRenderer> renderer_;
     float sceneRadius_ = 1.0f;
 
@@ -216,7 +228,7 @@ Status Viewer::startBake() {
     if (!baker) return baker.status();
     baker_ = std::move(baker.value());
     if (!renderer_) {  // kept across restarts: same mesh, textures uploaded once
-        auto renderer = SceneRenderer::create(loaded_.scene, baker_->mesh(), loaded_.layout.resolution);
+        auto renderer = SceneRenderer::create(loaded_.scene, mesh(), loaded_.layout.resolution);
         if (!renderer) return renderer.status();
         renderer_ = std::move(renderer.value());
     }
@@ -230,9 +242,21 @@ Status Viewer::startBake() {
     bakeDoneAt_ = -1;
     bakeStart_ = Clock::now();
     lastExposureUpdate_ = -1e9;
-    logInfo("bake set up in " + std::to_string(secondsSince(t0)) + " s: " + std::to_string(baker_->mesh().triangleCount()) +
+    logInfo("bake set up in " + std::to_string(secondsSince(t0)) + " s: " + std::to_string(mesh().triangleCount()) +
             " triangles, " + std::to_string(loaded_.layout.pageCount) + " page(s) of " +
             std::to_string(loaded_.layout.resolution) + "^2 texels, " + std::to_string(options_.directions) + " directions");
+    return Status::ok();
+}
+
+Status Viewer::showOpened() {
+    openedMesh_ = buildBakeMesh(loaded_.scene, loaded_.layout);
+    auto renderer = SceneRenderer::create(loaded_.scene, *openedMesh_, loaded_.layout.resolution);
+    if (!renderer) return renderer.status();
+    renderer_ = std::move(renderer.value());
+    renderer_->uploadLightmaps(*opened_);
+    logInfo("showing the bake in " + args_.open + ": " + std::to_string(openedMesh_->triangleCount()) + " triangles, " +
+            std::to_string(loaded_.layout.pageCount) + " page(s) of " + std::to_string(loaded_.layout.resolution) +
+            "^2 texels (" + cli::uvLayoutName(loaded_.layout.mode) + " layout from its manifest.json)");
     return Status::ok();
 }
 
@@ -263,7 +287,7 @@ void Viewer::bakeStep() {
 
 RenderView Viewer::currentView(int width, int height) const {
     const float aspect = float(width) / float(std::max(height, 1));
-    return viewFromCamera(camera_.toCamera(sceneRadius_), aspect, baker_->mesh().bounds);
+    return viewFromCamera(camera_.toCamera(sceneRadius_), aspect, mesh().bounds);
 }
 
 void Viewer::updateAutoExposure(bool force) {
@@ -363,7 +387,7 @@ void Viewer::handleInput(double dt) {
         if (ImGui::IsKeyPressed(GLFW_KEY_F)) {
             int width = 0, height = 0;
             glfwGetFramebufferSize(w, &width, &height);
-            frameScene(camera_, baker_->mesh().bounds, float(width) / float(std::max(height, 1)));
+            frameScene(camera_, mesh().bounds, float(width) / float(std::max(height, 1)));
             moved = true;
         }
         if (ImGui::IsKeyPressed(GLFW_KEY_TAB)) camera_.fly = !camera_.fly;
@@ -371,7 +395,7 @@ void Viewer::handleInput(double dt) {
         if (ImGui::IsKeyPressed(GLFW_KEY_T)) settings_.tileOverlay = !settings_.tileOverlay;
         for (int k = 0; k < 9 && k < int(loaded_.scene.cameras.size()); ++k)
             if (ImGui::IsKeyPressed(GLFW_KEY_1 + k)) {
-                useSceneCamera(camera_, cameraInLocalSpace(loaded_.scene.cameras[size_t(k)], baker_->mesh().origin), baker_->mesh().bounds);
+                useSceneCamera(camera_, cameraInLocalSpace(loaded_.scene.cameras[size_t(k)], mesh().origin), mesh().bounds);
                 cameraChoice_ = k;
             }
     }
@@ -382,13 +406,15 @@ void Viewer::drawPanel() {
     ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowSize(ImVec2(360, 0), ImGuiCond_FirstUseEver);
     ImGui::Begin("bundlebake");
-    const BakeStats& stats = baker_->stats();
-    const BakeProgress progress = baker_->progress();
     ImGui::TextUnformatted(loaded_.scene.path.c_str());
-    ImGui::Text("%zu triangles, %d page(s) of %d^2 texels", baker_->mesh().triangleCount(), loaded_.layout.pageCount,
+    ImGui::Text("%zu triangles, %d page(s) of %d^2 texels", mesh().triangleCount(), loaded_.layout.pageCount,
                 loaded_.layout.resolution);
+    if (!baker_) ImGui::Text("light maps of %s (%s layout)", args_.open.c_str(), cli::uvLayoutName(loaded_.layout.mode));
+    static const BakeStats noStats;
+    const BakeStats& stats = baker_ ? baker_->stats() : noStats;
+    const BakeProgress progress = baker_ ? baker_->progress() : BakeProgress{};
 
-    if (ImGui::CollapsingHeader("Bake", ImGuiTreeNodeFlags_DefaultOpen)) {
+    if (baker_ && ImGui::CollapsingHeader("Bake", ImGuiTreeNodeFlags_DefaultOpen)) {
         char overlay[64];
         std::snprintf(overlay, sizeof overlay, "%d / %d directions", progress.directionsDone, progress.directionsTotal);
         ImGui::ProgressBar(float(progress.directionsDone) / float(std::max(progress.directionsTotal, 1)), ImVec2(-1, 0),
@@ -420,7 +446,7 @@ void Viewer::drawPanel() {
         mean /= std::max<size_t>(recentFrames_.size(), 1);
         ImGui::Text("frame %.1f ms (max %.1f over the last %zu)", mean * 1e3, worst * 1e3, recentFrames_.size());
     }
-    if (ImGui::CollapsingHeader("Memory", ImGuiTreeNodeFlags_DefaultOpen)) {
+    if (baker_ && ImGui::CollapsingHeader("Memory", ImGuiTreeNodeFlags_DefaultOpen)) {
         ImGui::Text("budget          %s", megabytes(options_.memoryBudget).c_str());
         ImGui::Text("node buffer     %s (%lld nodes)", megabytes(stats.nodeBufferBytes).c_str(),
                     (long long)stats.nodeCapacity);
@@ -431,7 +457,7 @@ void Viewer::drawPanel() {
         ImGui::Text("GPU now / peak  %s / %s", megabytes(MemoryTracker::gpu().current()).c_str(),
                     megabytes(MemoryTracker::gpu().peak()).c_str());
     }
-    if (ImGui::CollapsingHeader("Tiles", ImGuiTreeNodeFlags_DefaultOpen)) {
+    if (baker_ && ImGui::CollapsingHeader("Tiles", ImGuiTreeNodeFlags_DefaultOpen)) {
         const Baker::BundleGrid g = baker_->bundleGrid();
         const int perSide = (g.gridSize + g.tileStep - 1) / std::max(g.tileStep, 1);
         ImGui::Text("direction %d: (%.3f, %.3f, %.3f)", std::max(progress.directionsDone - 1, 0), g.dir.x, g.dir.y, g.dir.z);
@@ -454,7 +480,7 @@ void Viewer::drawPanel() {
         }
 #ifdef BUNDLEBAKE_VIEWER_IMPORTANCE
         if (!renderer_->hasImportance() && ImGui::Button("compute importance (CPU)")) {
-            Importance imp = computeImportance(baker_->mesh(), loaded_.layout.resolution);
+            Importance imp = computeImportance(mesh(), loaded_.layout.resolution);
             if (Status s = renderer_->setImportance(imp.importance); !s) message_ = s.message();
         }
 #else
@@ -471,7 +497,7 @@ void Viewer::drawPanel() {
             for (size_t c = 0; c < loaded_.scene.cameras.size(); ++c)
                 if (ImGui::Selectable((std::to_string(c + 1) + ": " + loaded_.scene.cameras[c].name).c_str(),
                                       cameraChoice_ == int(c))) {
-                    useSceneCamera(camera_, cameraInLocalSpace(loaded_.scene.cameras[c], baker_->mesh().origin), baker_->mesh().bounds);
+                    useSceneCamera(camera_, cameraInLocalSpace(loaded_.scene.cameras[c], mesh().origin), mesh().bounds);
                     cameraChoice_ = int(c);
                 }
             ImGui::EndCombo();
@@ -485,7 +511,7 @@ void Viewer::drawPanel() {
         if (ImGui::Button("frame (F)")) {
             int width = 0, height = 0;
             glfwGetFramebufferSize(context_->window(), &width, &height);
-            frameScene(camera_, baker_->mesh().bounds, float(width) / float(std::max(height, 1)));
+            frameScene(camera_, mesh().bounds, float(width) / float(std::max(height, 1)));
             cameraChoice_ = -1;
         }
         float fovDegrees = glm::degrees(camera_.yfov);
@@ -494,8 +520,8 @@ void Viewer::drawPanel() {
         ImGui::TextDisabled("WASD QE: move (Shift: faster), 1-9: glTF cameras");
     }
     if (ImGui::CollapsingHeader("Save")) {
-        ImGui::InputText("light map dir", &outputDir_);
-        if (ImGui::Button("save light maps")) {
+        if (baker_) ImGui::InputText("light map dir", &outputDir_);
+        if (baker_ && ImGui::Button("save light maps")) {
             Status s = saveLightmaps(outputDir_);
             message_ = s ? "wrote " + outputDir_ + " at " + std::to_string(progress.directionsDone) + " directions"
                          : s.message();
@@ -540,8 +566,8 @@ int Viewer::run() {
         autoExposure_ = false;
     }
     outputDir_ = args_.output;
-    if (Status s = startBake(); !s) return cli::fail(s.message());
-    sceneRadius_ = std::max(0.5f * glm::length(baker_->mesh().bounds.size()), 1e-4f);
+    if (Status s = opened_ ? showOpened() : startBake(); !s) return cli::fail(s.message());
+    sceneRadius_ = std::max(0.5f * glm::length(mesh().bounds.size()), 1e-4f);
 
     // camera: frame the scene on load, along glTF camera 0's view if the scene has one
     int width = 0, height = 0;
@@ -551,15 +577,15 @@ int Viewer::run() {
         return cli::fail("--camera " + std::to_string(args_.camera) + ": the scene has " +
                          std::to_string(loaded_.scene.cameras.size()) + " camera(s)");
     if (args_.camera >= 0) {
-        useSceneCamera(camera_, cameraInLocalSpace(loaded_.scene.cameras[size_t(args_.camera)], baker_->mesh().origin), baker_->mesh().bounds);
+        useSceneCamera(camera_, cameraInLocalSpace(loaded_.scene.cameras[size_t(args_.camera)], mesh().origin), mesh().bounds);
         cameraChoice_ = args_.camera;
     } else {
         if (!loaded_.scene.cameras.empty()) {
-            useSceneCamera(camera_, cameraInLocalSpace(loaded_.scene.cameras[0], baker_->mesh().origin), baker_->mesh().bounds);
+            useSceneCamera(camera_, cameraInLocalSpace(loaded_.scene.cameras[0], mesh().origin), mesh().bounds);
         } else {
             camera_.setForward(DEFAULT_FRAMING_DIRECTION);
         }
-        frameScene(camera_, baker_->mesh().bounds, aspect);
+        frameScene(camera_, mesh().bounds, aspect);
     }
 
     IMGUI_CHECKVERSION();
@@ -574,12 +600,12 @@ int Viewer::run() {
     int exitCode = 0;
     while (!glfwWindowShouldClose(window)) {
         glfwPollEvents();
-        const bool baking = !paused_ && !baker_->progress().done();
+        const bool baking = baker_ && !paused_ && !baker_->progress().done();
         auto bakeBegin = Clock::now();
         bakeStep();
         const double bakePart = secondsSince(bakeBegin);
         const double now = glfwGetTime();
-        rateWindow_.emplace_back(now, baker_->progress().directionsDone);
+        rateWindow_.emplace_back(now, baker_ ? baker_->progress().directionsDone : 0);
         while (rateWindow_.size() > 2 && now - rateWindow_.front().first > 3.0) rateWindow_.pop_front();
         if (rateWindow_.size() >= 2 && rateWindow_.back().first > rateWindow_.front().first)
             directionsPerSecond_ = (rateWindow_.back().second - rateWindow_.front().second) /
@@ -593,7 +619,7 @@ int Viewer::run() {
         const double dt = std::chrono::duration<double>(nowTime - last).count();
         handleInput(dt);
         drawPanel();
-        if (!baker_ || !renderer_) {  // a restart failed (logged)
+        if ((!baker_ && !opened_) || !renderer_) {  // a restart failed (logged)
             ImGui::EndFrame();
             exitCode = 1;
             break;
@@ -629,14 +655,17 @@ int Viewer::run() {
                     exitCode = cli::fail(s.message());
                 } else {
                     logInfo("screenshot after " + std::to_string(frame) + " frames (" +
-                            std::to_string(baker_->progress().directionsDone) + " directions) -> " + args_.screenshot);
+                            std::to_string(baker_ ? baker_->progress().directionsDone : 0) + " directions" +
+                            (baker_ ? "" : ", light maps of " + args_.open) + ") -> " + args_.screenshot);
                 }
             }
             break;
         }
     }
     logFrameTimes();
-    if (args_.saveAtExit && exitCode == 0) {
+    if (args_.saveAtExit && exitCode == 0 && !baker_) {
+        exitCode = cli::fail("--save-lightmaps: nothing was baked (--open shows a bake)");
+    } else if (args_.saveAtExit && exitCode == 0) {
         if (Status s = saveLightmaps(outputDir_); !s)
             exitCode = cli::fail(s.message());
         else
@@ -654,6 +683,11 @@ int runViewer(int argc, char** argv) {
     ViewerArgs a;
     CLI::App app{"bundlebake-viewer: watch the light maps of a bake converge (GLFW, OpenGL 4.3)"};
     cli::addSceneOptions(app, a.scene);
+    app.get_option("scene")->required(false)->description(
+        "glTF 2.0 scene (.gltf or .glb); with --open, the bake's scene when left out");
+    app.add_option("--open", a.open,
+                   "Show a finished bake (a `bundlebake bake` OUTDIR) instead of baking: its manifest.json gives the "
+                   "layout and the scene, its EXR pages the light maps");
     app.add_option("--directions", a.directions, "Bundle directions (each serves d and -d)")
         ->check(CLI::Range(1, 1 << 20))
         ->capture_default_str();
@@ -702,6 +736,8 @@ int runViewer(int argc, char** argv) {
         return 2;
     }
     setLogLevel(verbose ? LogLevel::Debug : LogLevel::Info);
+    a.given = cli::layoutFlagsGiven(app);
+    if (a.scene.scene.empty() && a.open.empty()) return cli::fail("a SCENE is needed (or --open BAKE_DIR)");
     if (!a.screenshot.empty() && a.frames <= 0) return cli::fail("--screenshot needs --frames N (N >= 1)");
 
     auto budget = cli::parseSize(a.memoryBudget, "--memory-budget");
@@ -721,14 +757,31 @@ int runViewer(int argc, char** argv) {
         if (!env) return cli::fail(env.error());
         options.environment = std::move(env.value());
     }
-    auto loaded = cli::loadSceneAndLayout(a.scene);
-    if (!loaded) return cli::fail(loaded.error());
+    std::optional<LightmapPages> opened;
+    Expected<cli::LoadedScene> loaded = Expected<cli::LoadedScene>::failure("not loaded");
+    if (!a.open.empty()) {
+        if (a.scene.scene.empty()) {
+            auto manifest = readBakeManifest(a.open);
+            if (!manifest) return cli::fail(manifest.error());
+            if (manifest->scene.empty()) return cli::fail(a.open + "/manifest.json names no scene: give the SCENE");
+            a.scene.scene = manifest->scene;
+        }
+        loaded = cli::loadSceneWithBakeLayout(a.scene, a.given, a.open);
+        if (!loaded) return cli::fail(loaded.error());
+        auto maps = readBakedLightmaps(a.open, loaded->layout);
+        if (!maps) return cli::fail(maps.error());
+        opened = std::move(maps.value());
+    } else {
+        loaded = cli::loadSceneAndLayout(a.scene);
+        if (!loaded) return cli::fail(loaded.error());
+    }
 
     const std::string title = "bundlebake - " + std::filesystem::path(a.scene.scene).filename().string();
     auto context = GlfwContext::create(a.width, a.height, title);
     if (!context) return cli::fail(context.error());
     logInfo("viewer: " + context.value()->caps().describe());
-    Viewer viewer(std::move(a), std::move(loaded.value()), std::move(options), std::move(context.value()));
+    Viewer viewer(std::move(a), std::move(loaded.value()), std::move(options), std::move(context.value()),
+                  std::move(opened));
     return viewer.run();
 }
 
