@@ -126,6 +126,7 @@ Status Baker::Impl::buildPrograms() {
         {&directFoldProgram, {"lightmap/direct_fold.comp"}, rounding},
         {&distanceProgram, {"direct/distance.vert", "direct/distance.frag"}, ""},
         {&emitterProgram, {"direct/emitter.vert", "direct/emitter.frag"}, ""},
+        {&punctualProgram, {"direct/emitter.vert", "direct/punctual.frag"}, ""},
     };
     for (auto& s : specs) {
         auto p = gl::buildProgram(s.files, s.defines);
@@ -199,8 +200,10 @@ void Baker::Impl::drawSurface(GLuint program, bool materialUniforms) {
     const GLint emissionUniform = glGetUniformLocation(program, "emission");
     const GLint hasAlbedoUniform = glGetUniformLocation(program, "hasAlbedoTexture");
     const GLint hasEmissionUniform = glGetUniformLocation(program, "hasEmissionTexture");
+    const GLint materialUniform = glGetUniformLocation(program, "material");  // cut-outs (coverage)
     for (const SurfaceRun& run : surfaceRuns) {
         glUniform1i(pageUniform, GLint(run.page));
+        glUniform1i(materialUniform, GLint(run.material));
         if (materialUniforms) {
             const Material& mat = materials[run.material];
             glUniform3fv(albedoUniform, 1, &mat.albedo.x);
@@ -224,6 +227,7 @@ void Baker::Impl::coveragePass() {
     const uint8_t none = DILATION_NONE;
     glClearTexImage(dilation.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_BYTE, &none);
     glBindImageTexture(BINDING_DILATION, dilation.id(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R8UI);
+    bindAlphaMasks();  // a cut-away texel centre is not covered
     drawSurface(coverageProgram.id(), false);
     // padding: the nearest covered texel, page by page on the CPU (once)
     const int res = layout.resolution;
@@ -294,6 +298,7 @@ Status Baker::Impl::init(const Scene& scene) {
         textureMeans.push_back(t.texels.empty() ? glm::vec3(1.0f) : glm::vec3(sum / double(t.texels.size())));
     }
     lights = scene.lights;
+    punctualLights = scene.punctualLights;
     inputKey = hashInputs(scene);
     stats.directionsTotal = options.directions;
     if (options.directions < 1) return Status::error("--directions must be at least 1");
@@ -408,6 +413,7 @@ Status Baker::Impl::init(const Scene& scene) {
     glNamedFramebufferParameteri(pageFbo.id(), GL_FRAMEBUFFER_DEFAULT_WIDTH, res);
     glNamedFramebufferParameteri(pageFbo.id(), GL_FRAMEBUFFER_DEFAULT_HEIGHT, res);
     uploadMaterials(scene);
+    uploadAlphaMasks(scene);
     if (options.environment) {
         MemoryCategory category("materials");
         const auto& env = *options.environment;
@@ -463,7 +469,7 @@ Status Baker::Impl::init(const Scene& scene) {
         // the bundle pass: its buffers start small and grow to what the tiles predict
         MemoryCategory category("bundles");
         const BundleScene scene{&mesh, &clusters, vao.id(), vertexBuffer.id(), triangleBuffer.id(), radiance.id(),
-                                pageFbo.id(), res};
+                                pageFbo.id(), res, materialAlphaBuffer.id(), alphaTexelBuffer.id()};
         const BundleLimits limits{nodeCapacity, maxTileSize, subpixelBits, options.predictTiles};
         auto t = BundleTracer::create(scene, limits,
                                       options.rounding == Rounding::Nearest ? "#define ROUNDING_NEAREST 1\n" : "", &stats);
@@ -483,6 +489,10 @@ Status Baker::Impl::init(const Scene& scene) {
     auto te = Clock::now();
     if (stats.explicitEmitters) {
         bakeEmitters();
+        foldDirect(false);
+    }
+    if (!punctualLights.empty()) {
+        bakePunctualLights();
         foldDirect(false);
     }
     glFinish();

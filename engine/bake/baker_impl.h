@@ -24,6 +24,7 @@ struct Baker::Impl {
     Layout layout;
     std::vector<Material> materials;
     std::vector<DirectionalLight> lights;
+    std::vector<PunctualLight> punctualLights;  // point and spot (direct_light.cpp)
     BakeStats stats;
     uint64_t inputKey = 0;  // hash of the materials, their textures and the lights (checkpoints)
     std::vector<glm::vec3> directions;
@@ -60,7 +61,8 @@ struct Baker::Impl {
     gl::Texture envTexture;
     gl::Framebuffer pageFbo;
     gl::Program updateProgram, sunProgram, resolveProgram, rescaleProgram, metaProgram, coverageProgram,
-        dilateProgram, directFoldProgram, distanceProgram, emitterProgram;
+        dilateProgram, directFoldProgram, distanceProgram, emitterProgram, punctualProgram;
+    gl::Buffer materialAlphaBuffer, alphaTexelBuffer;  // cut-outs (glsl/shared/material_layout.h; cutouts.cpp)
     std::vector<glm::vec3> textureMeans;  // mean linear RGB of each scene texture (explicit emitters)
     std::vector<gl::Texture> materialTextures;
     struct SurfaceRun {
@@ -93,6 +95,9 @@ struct Baker::Impl {
     void foldDirect(bool perSample);
     bool useExplicitEmitters() const;
     void bakeEmitters();
+    void uploadAlphaMasks(const Scene& scene);      // cutouts.cpp: the tables, bound at their SSBO bindings
+    void bindAlphaMasks() const;
+    void bakePunctualLights();    // point and spot lights into the direct sums (direct_light.cpp)
     // The root square of direction d: the uniform grid, or the adaptive root.
     // jitter: in units of jitterUnit (scene units) in adaptive roots, of the uniform pixel otherwise.
     BundleFrame bundleFrame(const glm::vec3& d, glm::vec2 jitter, bool uniformGrid, double jitterUnit) const;

@@ -9,6 +9,7 @@
 #include "gl/gl.h"
 #include "gl/shader.h"
 #include "glsl/shared/bundle_layout.h"
+#include "glsl/shared/material_layout.h"
 
 namespace bb {
 
@@ -125,6 +126,10 @@ void BundleTracer::next(const UpdateFn& update) {
     // what both passes read (the mesh's SSBOs: per chunk, in drawClusters)
     glBindVertexArray(scene_.vertexArray);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_NODES, nodes_.id());
+    if (scene_.materialAlpha) {
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_MATERIAL_ALPHA, scene_.materialAlpha);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_ALPHA_TEXELS, scene_.alphaTexels);
+    }
 
     auto tb = Clock::now();
     {

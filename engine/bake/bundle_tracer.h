@@ -50,6 +50,8 @@ struct BundleScene {
     GLuint radiance = 0;      // outgoing radiance per texel (the bundle pass reads it)
     GLuint pageFramebuffer = 0;
     int pageResolution = 0;
+    // cut-outs (glsl/shared/material_layout.h): per material alpha and the masks' texels
+    GLuint materialAlpha = 0, alphaTexels = 0;
 };
 
 struct BundleLimits {

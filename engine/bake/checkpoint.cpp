@@ -101,10 +101,21 @@ uint64_t Baker::Impl::hashInputs(const Scene& scene) {
         const int32_t ints[] = {mat.albedoTexture, mat.emissionTexture, mat.doubleSided ? 1 : 0};
         h = fnv1a(values, sizeof values, h);
         h = fnv1a(ints, sizeof ints, h);
+        if (mat.alphaMask) {  // cut-outs (only then: other scenes keep their keys)
+            const float alpha[] = {mat.alphaCutoff, mat.alpha};
+            h = fnv1a(alpha, sizeof alpha, h);
+        }
     }
     for (const Texture& t : scene.textures) h = fnv1a(t.texels.data(), t.texels.size() * sizeof(glm::vec4), h);
     for (const DirectionalLight& l : scene.lights) {
         const float values[] = {l.direction.x, l.direction.y, l.direction.z, l.irradiance.r, l.irradiance.g, l.irradiance.b};
+        h = fnv1a(values, sizeof values, h);
+    }
+    for (const PunctualLight& l : scene.punctualLights) {
+        const double position[] = {l.position.x, l.position.y, l.position.z};
+        const float values[] = {float(l.type == PunctualLight::Type::Spot), l.direction.x, l.direction.y, l.direction.z,
+                                l.intensity.r, l.intensity.g, l.intensity.b, l.range, l.innerConeAngle, l.outerConeAngle};
+        h = fnv1a(position, sizeof position, h);
         h = fnv1a(values, sizeof values, h);
     }
     return h;

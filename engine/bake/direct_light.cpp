@@ -1,6 +1,8 @@
-// Direct light: the sun as exact shadow bundles (jittered sub-pixel), and
-// small emitters lit explicitly (exact polygon form factor times visibility
-// from shadow cube maps); the bundles then carry only the reflected light.
+// Direct light: the sun as exact shadow bundles (jittered sub-pixel), small
+// emitters lit explicitly (exact polygon form factor times visibility from
+// shadow cube maps), and point and spot lights (closed-form irradiance times
+// visibility from a shadow cube map at the light); the bundles then carry
+// only the reflected light.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -15,6 +17,53 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 namespace bb {
+namespace {
+
+// A distance cube map around a point (an emitter sample, a point or spot
+// light): per texel the distance to the nearest surface the texel's ray meets;
+// cut-outs' cut-away parts are not drawn (direct/distance.frag).
+struct DistanceCube {
+    gl::Texture cube, depth;
+    gl::Framebuffer fbo;
+    int size = 0;
+    MeshChunks chunks;
+
+    DistanceCube(int faceSize, GLuint triangleBuffer, int64_t triangles) : size(faceSize) {
+        cube = gl::Texture::createCube("shadow cube distances", GL_R32F, size);
+        glTextureParameteri(cube.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTextureParameteri(cube.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        depth = gl::Texture::create2D("shadow cube depth", GL_DEPTH_COMPONENT32F, size, size);
+        fbo = gl::Framebuffer::create("shadow cube face");
+        glNamedFramebufferTexture(fbo.id(), GL_DEPTH_ATTACHMENT, depth.id(), 0);
+        // the per-triangle material and flags (cut-outs), bound in chunks
+        chunks = MeshChunks::create(triangles, {{MESH_BINDING_TRIANGLES, triangleBuffer, int64_t(sizeof(BakeTriangle))}});
+    }
+
+    // Draws the whole mesh into the six faces around `point`, distances up to farPlane.
+    void render(GLuint vertexArray, const gl::Program& program, const glm::vec3& point, float nearPlane, float farPlane) {
+        static const glm::vec3 faceDir[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+        static const glm::vec3 faceUp[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
+        const glm::mat4 projection = glm::perspective(glm::radians(90.0f), 1.0f, nearPlane, farPlane);
+        const float farValue = 1e30f;
+        glBindVertexArray(vertexArray);
+        glUseProgram(program.id());
+        glUniform3fv(program.uniform("samplePoint"), 1, &point.x);
+        glEnable(GL_DEPTH_TEST);
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
+        glViewport(0, 0, size, size);
+        for (int f = 0; f < 6; ++f) {
+            glNamedFramebufferTextureLayer(fbo.id(), GL_COLOR_ATTACHMENT0, cube.id(), 0, f);
+            glm::mat4 clipFromWorld = projection * glm::lookAt(point, point + faceDir[f], faceUp[f]);
+            glUniformMatrix4fv(program.uniform("clipFromWorld"), 1, GL_FALSE, &clipFromWorld[0][0]);
+            glClearNamedFramebufferfv(fbo.id(), GL_COLOR, 0, &farValue);
+            glClearNamedFramebufferfi(fbo.id(), GL_DEPTH_STENCIL, 0, 1.0f, 0);
+            chunks.drawArrays(program.id(), 0, chunks.triangleCount());
+        }
+        glDisable(GL_DEPTH_TEST);
+    }
+};
+
+}  // namespace
 
 void Baker::Impl::bakeSun() {
     MemoryCategory category("bundles");
@@ -82,6 +131,7 @@ void Baker::Impl::bakeEmitters() {
         totalPower += power;
     }
     if (emitters.empty()) return;
+    bindAlphaMasks();
     for (auto& e : emitters)
         e.samples = std::max(1, int(std::lround(options.emitterSamples * (totalPower > 0 ? e.power / totalPower : 0.0))));
 
@@ -94,18 +144,8 @@ void Baker::Impl::bakeEmitters() {
         size = 64;
         while (size < 4 * gridSize && size < 512) size *= 2;
     }
-    gl::Texture cube = gl::Texture::createCube("emitter sample distances", GL_R32F, size);
-    glTextureParameteri(cube.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTextureParameteri(cube.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    gl::Texture depth = gl::Texture::create2D("emitter sample depth", GL_DEPTH_COMPONENT32F, size, size);
-    gl::Framebuffer fbo = gl::Framebuffer::create("emitter sample cube face");
-    glNamedFramebufferTexture(fbo.id(), GL_DEPTH_ATTACHMENT, depth.id(), 0);
-
-    const glm::vec3 faceDir[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-    const glm::vec3 faceUp[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
+    DistanceCube cube(size, triangleBuffer.id(), int64_t(mesh.triangles.size()));
     const float nearPlane = 1e-4f * sphereRadius, farPlane = 4.0f * sphereRadius;
-    const glm::mat4 projection = glm::perspective(glm::radians(90.0f), 1.0f, nearPlane, farPlane);
-    const float farValue = 1e30f;
     const float normalOffset = 0.5f * pixelSize;
     // Bias: a quarter bundle pixel, plus (in the shader) half a cube texel's
     // footprint at the receiver's distance, the error of a nearest lookup.
@@ -128,20 +168,7 @@ void Baker::Impl::bakeEmitters() {
             }
             glm::vec3 point = a + float(su) * (b - a) + float(sv) * (c - a) + n * (1e-4f * pixelSize);
             // distance cube map
-            glUseProgram(distanceProgram.id());
-            glUniform3fv(distanceProgram.uniform("samplePoint"), 1, &point.x);
-            glEnable(GL_DEPTH_TEST);
-            glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
-            glViewport(0, 0, size, size);
-            for (int f = 0; f < 6; ++f) {
-                glNamedFramebufferTextureLayer(fbo.id(), GL_COLOR_ATTACHMENT0, cube.id(), 0, f);
-                glm::mat4 clipFromWorld = projection * glm::lookAt(point, point + faceDir[f], faceUp[f]);
-                glUniformMatrix4fv(distanceProgram.uniform("clipFromWorld"), 1, GL_FALSE, &clipFromWorld[0][0]);
-                glClearNamedFramebufferfv(fbo.id(), GL_COLOR, 0, &farValue);
-                glClearNamedFramebufferfi(fbo.id(), GL_DEPTH_STENCIL, 0, 1.0f, 0);
-                glDrawArrays(GL_TRIANGLES, 0, drawFirstVertex(int64_t(mesh.triangles.size())));
-            }
-            glDisable(GL_DEPTH_TEST);
+            cube.render(vao.id(), distanceProgram, point, nearPlane, farPlane);
             // accumulate this sample's share into the direct map, page by page
             glUseProgram(emitterProgram.id());
             glUniform3fv(emitterProgram.uniform("emitterA"), 1, &a.x);
@@ -154,7 +181,7 @@ void Baker::Impl::bakeEmitters() {
             glUniform1f(emitterProgram.uniform("normalOffset"), normalOffset);
             glUniform1f(emitterProgram.uniform("distanceBias"), distanceBias);
             glUniform1f(emitterProgram.uniform("footprintPerDistance"), 1.0f / float(size));
-            glBindTextureUnit(0, cube.id());
+            glBindTextureUnit(0, cube.cube.id());
             glBindImageTexture(BINDING_SCRATCH_RG, accumAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32F);
             glBindImageTexture(BINDING_SCRATCH_B, radianceAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
             glBindFramebuffer(GL_FRAMEBUFFER, pageFbo.id());
@@ -167,6 +194,60 @@ void Baker::Impl::bakeEmitters() {
             glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
             ++stats.emitterSampleCount;
         }
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+// Point and spot lights: each a distance cube map at its position (as an
+// emitter sample's) and the closed-form irradiance (scene/punctual_light.h)
+// times that visibility, per texel, into the direct light's float sums.
+// A spot light draws the whole cube too (the cone is tested per texel).
+void Baker::Impl::bakePunctualLights() {
+    gl::DebugGroup group("point and spot lights");
+    MemoryCategory category("direct light");
+    // the cube face as the emitters' (4 cube texels per bundle pixel across)
+    int size = options.emitterShadowSize;
+    if (size <= 0) {
+        size = 64;
+        while (size < 4 * gridSize && size < 512) size *= 2;
+    }
+    DistanceCube cube(size, triangleBuffer.id(), int64_t(mesh.triangles.size()));
+    bindAlphaMasks();
+    // biases as the emitters' (bakeEmitters says why)
+    const float normalOffset = 0.5f * pixelSize;
+    const float distanceBias = 0.25f * pixelSize;
+    for (const PunctualLight& light : punctualLights) {
+        const glm::vec3 position(light.position - mesh.origin);  // local space, as the mesh
+        // every surface lies within |position - centre| + radius of the light
+        const float reach = glm::length(position - sphereCenter) + sphereRadius;
+        const float nearPlane = 1e-4f * sphereRadius, farPlane = 1.01f * reach + sphereRadius;
+        cube.render(vao.id(), distanceProgram, position, nearPlane, farPlane);
+
+        const glm::vec3 intensity = light.intensity / radianceUnit;
+        const float cosOuter = std::cos(light.outerConeAngle), cosInner = std::cos(light.innerConeAngle);
+        const GLuint p = punctualProgram.id();
+        glUseProgram(p);
+        glUniform3fv(punctualProgram.uniform("lightPosition"), 1, &position.x);
+        glUniform3fv(punctualProgram.uniform("lightIntensity"), 1, &intensity.x);
+        glUniform1f(punctualProgram.uniform("lightRange"), light.range);
+        glUniform1i(punctualProgram.uniform("lightIsSpot"), light.type == PunctualLight::Type::Spot);
+        glUniform3fv(punctualProgram.uniform("spotDirection"), 1, &light.direction.x);
+        glUniform1f(punctualProgram.uniform("spotCosOuter"), cosOuter);
+        glUniform1f(punctualProgram.uniform("spotScale"), 1.0f / std::max(0.001f, cosInner - cosOuter));
+        glUniform1f(punctualProgram.uniform("normalOffset"), normalOffset);
+        glUniform1f(punctualProgram.uniform("distanceBias"), distanceBias);
+        glUniform1f(punctualProgram.uniform("footprintPerDistance"), 1.0f / float(size));
+        glBindTextureUnit(0, cube.cube.id());
+        glBindImageTexture(BINDING_SCRATCH_RG, accumAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32F);
+        glBindImageTexture(BINDING_SCRATCH_B, radianceAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
+        glBindFramebuffer(GL_FRAMEBUFFER, pageFbo.id());
+        glViewport(0, 0, layout.resolution, layout.resolution);
+        for (int page = 0; page < layout.pageCount; ++page) {
+            glUniform1i(glGetUniformLocation(p, "page"), page);
+            const int64_t count = int64_t(mesh.pageFirstTriangle[page + 1]) - mesh.pageFirstTriangle[page];
+            if (count) glDrawArrays(GL_TRIANGLES, drawFirstVertex(mesh.pageFirstTriangle[page]), GLsizei(count * 3));
+        }
+        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }

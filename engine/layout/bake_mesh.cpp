@@ -68,6 +68,7 @@ BakeMesh buildBakeMesh(const Scene& scene, const Layout& layout) {
             uint32_t flags = 0;
             if (material.doubleSided) flags |= TRIANGLE_DOUBLE_SIDED;
             if (emits(material)) flags |= TRIANGLE_EMISSIVE;
+            if (material.alphaMask) flags |= TRIANGLE_ALPHA_MASK;
 
             for (size_t t = 0; t < prim.triangleCount(); ++t) {
                 const uint32_t slot = cursor[size_t(rect.page)]++;

@@ -2,6 +2,7 @@
 // See reference_baker.h for the model and the sampling; the notes here are
 // about how.
 #include "reference/reference_baker.h"
+#include "scene/punctual_light.h"
 
 #include <algorithm>
 #include <array>
@@ -222,6 +223,7 @@ struct ReferenceBaker::Impl {
     std::vector<Material> materials;
     std::vector<Texture> textures;
     std::vector<DirectionalLight> lights;
+    std::vector<PunctualLight> punctualLights;
     ReferenceStats stats;
 
     std::vector<glm::vec3> triNormal;     // geometric, unit, counter-clockwise front
@@ -255,6 +257,7 @@ struct ReferenceBaker::Impl {
     glm::vec3 albedoAt(const Material& m, glm::vec2 uv0) const;
     glm::vec3 emissionAt(const Material& m, glm::vec2 uv0) const;
     glm::vec3 directLight(const SurfacePoint& x, const glm::vec3& beta, float u1, float u2, Counters& counters) const;
+    glm::vec3 punctualLight(const SurfacePoint& x, Counters& counters) const;
 };
 
 void embreeError(void*, RTCError code, const char* message) {
@@ -273,6 +276,7 @@ Status ReferenceBaker::Impl::init(const Scene& scene) {
     materials = scene.materials;
     textures = scene.textures;
     lights = scene.lights;
+    punctualLights = scene.punctualLights;
     stats.sppTotal = options.spp;
     stats.threads = options.threads;
     stats.lightmapTexels = int64_t(layout.texelCount());
@@ -684,6 +688,7 @@ glm::vec3 ReferenceBaker::Impl::directLight(const SurfacePoint& x, const glm::ve
         if (!occluded(origin, toSun, std::numeric_limits<float>::infinity()))
             sum += light.irradiance * (c * INV_PI);
     }
+    sum += punctualLight(x, counters);
     if (options.emitterSampling && !emitters.empty()) {
         // pick by power with u1, then reuse u1 within the pick's interval: the 2D
         // point stays stratified over all emitters together
@@ -721,6 +726,24 @@ glm::vec3 ReferenceBaker::Impl::directLight(const SurfacePoint& x, const glm::ve
         }
     }
     return beta * sum;
+}
+
+// Point and spot lights at x (exact: closed-form irradiance, one shadow ray
+// each), as L_lm contributions.
+glm::vec3 ReferenceBaker::Impl::punctualLight(const SurfacePoint& x, Counters& counters) const {
+    glm::vec3 sum(0.0f);
+    const glm::vec3 origin = x.p + x.ng * eps;
+    for (const PunctualLight& light : punctualLights) {
+        const glm::vec3 position(light.position - mesh.origin);  // local space
+        const glm::vec3 e = punctualIrradiance(light, position, x.p, x.ns);
+        if (maxComponent(e) <= 0.0f) continue;
+        const glm::vec3 toLight = position - origin;
+        const float dist = glm::length(toLight);
+        if (!(dist > 2.0f * eps) || glm::dot(x.ng, toLight) <= 0.0f) continue;
+        ++counters.shadowRays;
+        if (!occluded(origin, toLight / dist, dist - 2.0f * eps)) sum += e * INV_PI;
+    }
+    return sum;
 }
 
 // One path from `start`: an estimate of L_lm there (light arriving, not leaving).

@@ -19,13 +19,18 @@
 // - extras.texelDensity on a node applies to its whole subtree until a
 //   descendant sets its own.
 // - Directional lights take the node's world linear transform applied to
-//   (0,0,-1), normalized (the rotation when the scale is uniform).
+//   (0,0,-1), normalized (the rotation when the scale is uniform); point and
+//   spot lights the node's world origin (in double) and, for spots, that
+//   direction. Cone angles are clamped to the spec's 0 <= inner <= outer <= pi/2;
+//   a range of 0 or none is infinite.
+// - alphaMode MASK: Material::alphaMask with baseColorFactor.a and alphaCutoff
+//   (the albedo texture keeps the base colour texture's alpha); BLEND bakes opaque.
 // - Images are kept encoded while tinygltf parses and decoded only when a used
 //   material needs them; one that cannot be read or decoded is an error (a bake
 //   without it would be silently wrong), an unused one is never looked at.
 // - Degenerate triangles: a repeated index, or |cross| <= 1e-12 * (diagonal of
 //   the primitive's bounding box)^2, computed in double from the float positions.
-// Not converted: alphaMode (cut-outs bake opaque), skins and morph targets (the
+// Not converted: alphaMode BLEND (bakes opaque), skins and morph targets (the
 // node's rest transform is used), KHR_materials_variants (the default mapping),
 // Draco/meshopt compression (an error: the geometry cannot be read).
 #include "scene/scene.h"
@@ -561,6 +566,11 @@ Status SceneBuilder::sceneMaterial(int gltfMaterial, int* out) {
     Material m;
     m.name = src.name.empty() ? "material " + std::to_string(gltfMaterial) : src.name;
     m.doubleSided = src.doubleSided;
+    // cut-outs: alphaMode MASK (scene/alpha_mask.h); BLEND bakes opaque
+    m.alphaMask = src.alphaMode == "MASK";
+    m.alphaCutoff = std::isfinite(src.alphaCutoff) ? std::max(float(src.alphaCutoff), 0.0f) : 0.5f;
+    m.alpha = pbr.baseColorFactor.size() >= 4 && std::isfinite(pbr.baseColorFactor[3])
+                  ? std::clamp(float(pbr.baseColorFactor[3]), 0.0f, 1.0f) : 1.0f;
     const glm::vec3 baseColor = glm::max(vec3Of(pbr.baseColorFactor, glm::vec3(1.0f)), glm::vec3(0.0f));
     const float metallic = std::clamp(float(pbr.metallicFactor), 0.0f, 1.0f);
     UvSource uv;
@@ -968,6 +978,29 @@ Status SceneBuilder::visitNode(int nodeIndex, const glm::dmat4& worldFromNode, f
                 deferWarning(scene_.path + ": " + label + ": directional light with a degenerate transform or "
                                                         "intensity skipped");
             }
+        } else if (src.type == "point" || src.type == "spot") {
+            PunctualLight light;
+            light.name = !src.name.empty() ? src.name : (!node.name.empty() ? node.name : "light " + std::to_string(int(*li)));
+            light.type = src.type == "spot" ? PunctualLight::Type::Spot : PunctualLight::Type::Point;
+            light.position = glm::dvec3(worldFromNode * glm::dvec4(0.0, 0.0, 0.0, 1.0));
+            light.intensity = glm::max(vec3Of(src.color, glm::vec3(1.0f)), glm::vec3(0.0f)) * float(src.intensity);
+            light.range = src.range > 0.0 && std::isfinite(src.range) ? float(src.range) : 0.0f;  // undefined: infinite
+            glm::dvec3 d = glm::dmat3(worldFromNode) * glm::dvec3(0.0, 0.0, -1.0);
+            const double len = glm::length(d);
+            // the spec: 0 <= inner < outer <= pi/2
+            const double outer = std::clamp(src.spot.outerConeAngle, 0.0, 0.5 * 3.14159265358979);
+            const double inner = std::clamp(src.spot.innerConeAngle, 0.0, outer);
+            light.outerConeAngle = float(outer);
+            light.innerConeAngle = float(inner);
+            const bool finite = std::isfinite(light.intensity.x + light.intensity.y + light.intensity.z) &&
+                                std::isfinite(light.position.x + light.position.y + light.position.z);
+            if (finite && src.intensity >= 0.0 && (light.type == PunctualLight::Type::Point || (len > 0.0 && std::isfinite(len)))) {
+                if (len > 0.0 && std::isfinite(len)) light.direction = glm::vec3(d / len);
+                scene_.punctualLights.push_back(std::move(light));
+            } else {
+                deferWarning(scene_.path + ": " + label + ": " + src.type +
+                             " light with a degenerate transform or intensity skipped");
+            }
         } else {
             ++skippedLights_;
         }
@@ -1067,8 +1100,7 @@ Status SceneBuilder::build() {
     }
     if (skippedLights_ > 0)
         deferWarning(scene_.path + ": skipped " + std::to_string(skippedLights_) +
-                   " point/spot light(s): only KHR_lights_punctual directional lights are baked "
-                   "(use emissive geometry instead)");
+                   " KHR_lights_punctual light(s) of an unknown type (directional, point and spot are baked)");
     if (badNormals_ > 0)
         deferWarning(scene_.path + ": " + std::to_string(badNormals_) +
                    " zero or non-finite normal(s) replaced by face normals");

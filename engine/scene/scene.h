@@ -1,5 +1,5 @@
 // The scene as bundlebake sees it: glTF 2.0 meshes, materials, instances,
-// directional lights and cameras, in scene units (whatever the file uses;
+// directional, point and spot lights and cameras, in scene units (whatever the file uses;
 // glTF means metres, the shared Cornell box uses millimetres).
 //
 // World and local coordinates: instance transforms are composed in double
@@ -38,6 +38,14 @@ struct Material {
     int emissionTexture = -1;      // index into Scene::textures, multiplies emission (TEXCOORD_0)
     bool doubleSided = false;
     bool isDefault = false;        // made by bundlebake for primitives without a material
+    // glTF alphaMode MASK (cut-outs: foliage, fences): where baseColor alpha x
+    // the albedo texture's alpha (TEXCOORD_0, bilinear, level 0, 8 bits; see
+    // scene/alpha_mask.h) is below alphaCutoff the surface is not there for
+    // any pass: light goes through, its texels are not covered. OPAQUE and
+    // BLEND bake opaque (alphaMask false).
+    bool alphaMask = false;
+    float alphaCutoff = 0.5f;      // glTF's default
+    float alpha = 1.0f;            // baseColorFactor.a
 };
 
 // One triangle list. Indices are always present (non-indexed glTF primitives
@@ -96,6 +104,22 @@ struct DirectionalLight {
     glm::vec3 irradiance{1.0f};
 };
 
+// KHR_lights_punctual "point" and "spot", in glTF's units: `intensity` is
+// colour * intensity in candela (lm/sr), so the irradiance at distance d on a
+// surface facing the light is E = intensity / d^2 (d in scene units; glTF means
+// metres, E is then lux), times the range window and the spot's cone falloff
+// (scene/punctual_light.h, the spec's recommended formulas).
+struct PunctualLight {
+    std::string name;
+    enum class Type { Point, Spot } type = Type::Point;
+    glm::dvec3 position{0.0};          // world space, exact (the node's translation, composed in double)
+    glm::vec3 direction{0.0f, 0.0f, -1.0f};  // spot: unit world direction the cone points (the node's -Z)
+    glm::vec3 intensity{1.0f};         // colour * intensity, candela
+    float range = 0.0f;                // > 0: smooth window clamp(1 - (d/range)^4, 0, 1); 0 = infinite (undefined)
+    float innerConeAngle = 0.0f;       // spot, radians: full intensity inside
+    float outerConeAngle = 0.7853982f; // spot, radians: nothing outside (glTF default pi/4)
+};
+
 struct Camera {
     std::string name;
     glm::mat4 worldFromCamera{1.0f};  // camera looks down its -Z, +Y up (glTF)
@@ -131,6 +155,7 @@ struct Scene {
     std::vector<Texture> textures;
     std::vector<Instance> instances;
     std::vector<DirectionalLight> lights;
+    std::vector<PunctualLight> punctualLights;  // point and spot lights
     std::vector<Camera> cameras;
     Bounds bounds;            // world space, over all instances (float: rounded far from the origin)
     // The local origin (world space, exact): BakeMesh positions are world - origin.

@@ -6,6 +6,8 @@
 #include "shared/mesh_layout.h"
 #include "lib/rounding.glsl"
 #include "lib/bundle_frame.glsl"
+#include "shared/material_layout.h"
+#include "lib/alpha_mask.glsl"
 
 flat in vec3 vDepthPlane;
 flat in vec3 vUPlane;
@@ -14,6 +16,9 @@ flat in uint vPage;
 flat in uint vFlags;
 flat in vec3 vFaceNormal;
 flat in uint vTriangle;
+flat in vec3 vUv0XPlane;
+flat in vec3 vUv0YPlane;
+flat in uint vMaterial;
 
 layout(binding = BINDING_NODE_COUNTER) uniform atomic_uint nodeCounter;
 layout(binding = BINDING_HEADS, r32ui) uniform coherent uimage2D heads;
@@ -24,11 +29,15 @@ uniform uint nodeCapacity;
 uniform uint randomSeed;  // per direction and leaf (not per tile: tiles change with the budget, the bytes must not)
 
 void main() {
-    uint index = atomicCounterIncrement(nodeCounter);
-    if (index >= nodeCapacity) return;  // overflow: the host sees counter > capacity and redraws split
     ivec2 pixel = ivec2(gl_FragCoord.xy);  // in the tile (the head image)
     ivec2 leafPixel = pixel + tileOffset;
     vec2 centre = vec2(leafPixel) + 0.5;
+    // a cut-out's cut-away part is not there: no node, light goes through
+    if ((vFlags & TRIANGLE_ALPHA_MASK) != 0u &&
+        alphaCut(vMaterial, vec2(dot(vUv0XPlane.xy, centre) + vUv0XPlane.z, dot(vUv0YPlane.xy, centre) + vUv0YPlane.z)))
+        return;
+    uint index = atomicCounterIncrement(nodeCounter);
+    if (index >= nodeCapacity) return;  // overflow: the host sees counter > capacity and redraws split
     float depth = dot(vDepthPlane.xy, centre) + vDepthPlane.z;
     vec2 lightmapUv = vec2(dot(vUPlane.xy, centre) + vUPlane.z, dot(vVPlane.xy, centre) + vVPlane.z);
     vec3 lo = textureLod(radiance, vec3(lightmapUv, float(vPage)), 0.0).rgb;

@@ -23,6 +23,10 @@ flat out uint vPage;
 flat out uint vFlags;
 flat out vec3 vFaceNormal;
 flat out uint vTriangle;
+// cut-outs: TEXCOORD_0 as planes too (the mask's edge must not move with the tile)
+flat out vec3 vUv0XPlane;
+flat out vec3 vUv0YPlane;
+flat out uint vMaterial;
 
 vec3 plane(vec2 p0, vec2 p1, vec2 p2, float a0, float a1, float a2, float det) {
     vec2 e1 = p1 - p0, e2 = p2 - p0;
@@ -57,14 +61,20 @@ void main() {
         vec2 uv0 = vertices[v0].lightmapUv, uv1 = vertices[v0 + 1u].lightmapUv, uv2 = vertices[v0 + 2u].lightmapUv;
         vUPlane = plane(p[0], p[1], p[2], uv0.x, uv1.x, uv2.x, det);
         vVPlane = plane(p[0], p[1], p[2], uv0.y, uv1.y, uv2.y, det);
+        vec2 t0 = vertices[v0].uv0, t1 = vertices[v0 + 1u].uv0, t2 = vertices[v0 + 2u].uv0;
+        vUv0XPlane = plane(p[0], p[1], p[2], t0.x, t1.x, t2.x, det);
+        vUv0YPlane = plane(p[0], p[1], p[2], t0.y, t1.y, t2.y, det);
     } else {
         // no area on the grid: no fragment either (kept finite all the same)
         vDepthPlane = vec3(0.0, 0.0, c[0].z);
         vUPlane = vec3(0.0, 0.0, inLightmapUv.x);
         vVPlane = vec3(0.0, 0.0, inLightmapUv.y);
+        vUv0XPlane = vec3(0.0, 0.0, inUv0.x);
+        vUv0YPlane = vec3(0.0, 0.0, inUv0.y);
     }
     uvec4 tri = bakeTriangle(t);
     vPage = tri.y;
+    vMaterial = tri.x;
     vFlags = tri.w;
     vFaceNormal = triangleSide(t);
     vTriangle = t;  // gl_PrimitiveID restarts with each draw of a multi-draw

@@ -1,9 +1,17 @@
 #version 430
-// Emitter sample visibility: distance from the sample point, one cube face.
+// Visibility of an emitter sample or a point/spot light: distance from the
+// sample point, one cube face.
 #include "lib/bake_vertex.glsl"
 uniform mat4 clipFromWorld;
 out vec3 vPosition;
+out vec2 vUv0;
+flat out uint vMaterial;
+flat out uint vFlags;
 void main() {
     vPosition = inPosition.xyz;
+    vUv0 = inUv0;
+    uvec4 tri = bakeTriangle(uint(gl_VertexID) / 3u);
+    vMaterial = tri.x;
+    vFlags = tri.w;
     gl_Position = clipFromWorld * vec4(inPosition.xyz, 1.0);
 }

@@ -2,7 +2,8 @@
 // The surface in light map space (meta.vert: one fragment per covered texel
 // centre; the draws run per page and material, `page` and the material's
 // uniforms set per run).
-// COVERAGE (define): marks the texel covered (DILATION_SELF), once at setup.
+// COVERAGE (define): marks the texel covered (DILATION_SELF), once at setup,
+// unless a cut-out's mask cuts its centre away (scene/alpha_mask.h).
 // Otherwise the outgoing pass: Lo = Le + albedo * L_lm, with L_lm = the
 // accumulators' running mean (the indirect light, see update.frag) + the direct
 // map, stochastically rounded into the RGB9E5 radiance map the bundle pass
@@ -15,9 +16,15 @@ in vec2 vUv0;
 uniform int page;
 
 #ifdef COVERAGE
+#include "shared/material_layout.h"
+#include "lib/alpha_mask.glsl"
 layout(binding = BINDING_DILATION, r8ui) uniform writeonly uimage2DArray dilation;
+uniform int material;  // the run's (cut-outs: a texel centre on a cut-away part is not covered)
 
-void main() { imageStore(dilation, ivec3(ivec2(gl_FragCoord.xy), page), uvec4(DILATION_SELF)); }
+void main() {
+    if (alphaCut(uint(material), vUv0)) return;
+    imageStore(dilation, ivec3(ivec2(gl_FragCoord.xy), page), uvec4(DILATION_SELF));
+}
 #else
 layout(binding = BINDING_MATERIAL_TEX) uniform sampler2D albedoTexture;
 layout(binding = BINDING_MATERIAL_TEX + 1) uniform sampler2D emissionTexture;

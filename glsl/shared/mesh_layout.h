@@ -9,6 +9,9 @@
 // cross(dFdx(P), dFdy(P)) = (p1 - p0) x (p2 - p0) / uv determinant: set where
 // the winding disagrees with the shading normals XOR the uv triangle is clockwise.
 #define TRIANGLE_DERIVATIVE_NORMAL_FLIPPED 4u
+// The material is a cut-out (alphaMode MASK): passes test its alpha at the
+// fragment (lib/alpha_mask.glsl); other triangles skip the lookup.
+#define TRIANGLE_ALPHA_MASK 8u
 
 // SSBO binding of BakeTriangle triangles[] (lib/bake_vertex.glsl), bound in
 // chunks by MeshChunks (engine/layout/bake_mesh_gl.h)
