@@ -568,12 +568,18 @@ TEST(SceneLoader, TinySceneFollowsEveryRule) {
     EXPECT_VEC3_NEAR(s.bounds.min, -1.0f, -1.0f, -1.0f, 1e-5f);
     EXPECT_VEC3_NEAR(s.bounds.max, 10.0f, 4.0f, 10.0f, 1e-5f);
 
-    // lights: the sun travels along world -Y; the point light is skipped with a warning
+    // lights: the sun travels along world -Y; the point light sits at its node's world origin
     ASSERT_EQ(s.lights.size(), 1u);
     EXPECT_EQ(s.lights[0].name, "Sun");
     EXPECT_VEC3_NEAR(s.lights[0].direction, 0.0f, -1.0f, 0.0f, 1e-6f);
     EXPECT_VEC3_NEAR(s.lights[0].irradiance, 8.0f, 4.0f, 2.0f, 1e-6f);
-    EXPECT_NE(log.find("skipped 1 point/spot light"), std::string::npos) << log;
+    ASSERT_EQ(s.punctualLights.size(), 1u);
+    EXPECT_EQ(s.punctualLights[0].name, "Bulb");
+    EXPECT_EQ(s.punctualLights[0].type, PunctualLight::Type::Point);
+    EXPECT_VEC3_NEAR(glm::vec3(s.punctualLights[0].position), 10.0f, 0.0f, 0.0f, 0.0f);
+    EXPECT_VEC3_NEAR(s.punctualLights[0].intensity, 100.0f, 100.0f, 100.0f, 0.0f);
+    EXPECT_EQ(s.punctualLights[0].range, 0.0f);  // undefined: infinite
+    EXPECT_EQ(log.find("light(s) of an unknown type"), std::string::npos) << log;
 
     // camera
     ASSERT_EQ(s.cameras.size(), 1u);
@@ -1009,6 +1015,82 @@ TEST(SceneLoaderReject, OtherGltfVersions) {
     const std::string glb1 = dir.file("v1.glb");
     writeBytes(glb1, glb.data(), glb.size());
     expectOneLineError(loadScene(glb1), glb1, {"container version 1", "2.0 only"});
+}
+
+}  // namespace
+}  // namespace bb
+
+namespace bb {
+namespace {
+
+// KHR_lights_punctual point and spot lights and alphaMode MASK (issue 12):
+// a spot on a node rotated 90 degrees about X (its -Z points down the world
+// -Y) translated to (1, 3, 2), range 5, cone angles 0.2 / 0.6; a spot with an
+// inner angle above its outer one (clamped to it) and an outer one above
+// pi/2 (clamped); cut-out, blended and opaque materials.
+TEST(SceneLoader, PunctualLightsAndCutouts) {
+    TempDir dir;
+    GltfBuilder b;
+    const float h = std::sqrt(0.5f);
+    const int pos = b.positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+    b.doc["materials"] = json::array(
+        {{{"name", "Leaf"}, {"alphaMode", "MASK"}, {"alphaCutoff", 0.3},
+          {"pbrMetallicRoughness", {{"baseColorFactor", {1.0, 1.0, 1.0, 0.8}}, {"metallicFactor", 0.0}}}},
+         {{"name", "Glass"}, {"alphaMode", "BLEND"}, {"pbrMetallicRoughness", {{"metallicFactor", 0.0}}}},
+         {{"name", "Fence"}, {"alphaMode", "MASK"}, {"pbrMetallicRoughness", {{"metallicFactor", 0.0}}}}});
+    b.doc["meshes"] = json::array({{{"name", "Tris"},
+                                    {"primitives",
+                                     {{{"attributes", {{"POSITION", pos}}}, {"material", 0}},
+                                      {{"attributes", {{"POSITION", pos}}}, {"material", 1}},
+                                      {{"attributes", {{"POSITION", pos}}}, {"material", 2}}}}}});
+    b.doc["nodes"] = json::array(
+        {{{"name", "Mesh"}, {"mesh", 0}},
+         {{"name", "Spot"}, {"translation", {1, 3, 2}}, {"rotation", {-h, 0, 0, h}},
+          {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}},
+         {{"name", "Odd"}, {"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}}});
+    b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+    b.doc["extensions"] = {
+        {"KHR_lights_punctual",
+         {{"lights",
+           {{{"name", "Lamp"}, {"type", "spot"}, {"color", {1.0, 0.5, 0.25}}, {"intensity", 40.0}, {"range", 5.0},
+             {"spot", {{"innerConeAngle", 0.2}, {"outerConeAngle", 0.6}}}},
+            {{"type", "spot"}, {"spot", {{"innerConeAngle", 1.0}, {"outerConeAngle", 0.9}}}}}}}}};
+    b.doc["scenes"] = json::array({{{"nodes", {0, 1, 2}}}});
+    b.doc["scene"] = 0;
+    const std::string path = b.write(dir.file("lights.gltf"));
+    testing::internal::CaptureStderr();
+    Expected<Scene> loaded = loadScene(path);
+    const std::string log = testing::internal::GetCapturedStderr();
+    ASSERT_TRUE(loaded) << loaded.error();
+    const Scene& s = *loaded;
+
+    ASSERT_EQ(s.punctualLights.size(), 2u);
+    const PunctualLight& lamp = s.punctualLights[0];
+    EXPECT_EQ(lamp.name, "Lamp");
+    EXPECT_EQ(lamp.type, PunctualLight::Type::Spot);
+    EXPECT_VEC3_NEAR(glm::vec3(lamp.position), 1.0f, 3.0f, 2.0f, 1e-12f);
+    EXPECT_VEC3_NEAR(lamp.direction, 0.0f, -1.0f, 0.0f, 1e-6f);
+    EXPECT_VEC3_NEAR(lamp.intensity, 40.0f, 20.0f, 10.0f, 1e-6f);
+    EXPECT_EQ(lamp.range, 5.0f);
+    EXPECT_FLOAT_EQ(lamp.innerConeAngle, 0.2f);
+    EXPECT_FLOAT_EQ(lamp.outerConeAngle, 0.6f);
+    const PunctualLight& odd = s.punctualLights[1];
+    EXPECT_EQ(odd.name, "Odd");
+    EXPECT_VEC3_NEAR(odd.direction, 0.0f, 0.0f, -1.0f, 1e-6f);  // the node's -Z
+    EXPECT_VEC3_NEAR(odd.intensity, 1.0f, 1.0f, 1.0f, 0.0f);    // glTF's defaults
+    EXPECT_EQ(odd.range, 0.0f);
+    EXPECT_FLOAT_EQ(odd.outerConeAngle, 0.9f);
+    EXPECT_FLOAT_EQ(odd.innerConeAngle, 0.9f);  // clamped to the outer angle
+
+    ASSERT_EQ(s.materials.size(), 3u);
+    EXPECT_TRUE(s.materials[0].alphaMask);
+    EXPECT_FLOAT_EQ(s.materials[0].alphaCutoff, 0.3f);
+    EXPECT_FLOAT_EQ(s.materials[0].alpha, 0.8f);
+    EXPECT_FALSE(s.materials[1].alphaMask);  // BLEND bakes opaque
+    EXPECT_TRUE(s.materials[2].alphaMask);
+    EXPECT_FLOAT_EQ(s.materials[2].alphaCutoff, 0.5f);  // glTF's default cutoff
+    EXPECT_FLOAT_EQ(s.materials[2].alpha, 1.0f);
+    EXPECT_EQ(log.find("unknown type"), std::string::npos) << log;
 }
 
 }  // namespace
