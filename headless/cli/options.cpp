@@ -202,11 +202,21 @@ int runInfo(const InfoArgs& args) {
     std::printf("materials    %zu (%zu emissive, %zu primitives use the default albedo)\n", s.materials.size(),
                 emissiveMaterials, s.report.primitivesWithoutMaterial);
     std::printf("emitters     %zu emissive triangles\n", s.emitterTriangleCount());
-    std::printf("lights       %zu directional\n", s.lights.size());
+    size_t spots = 0, cutouts = 0;
+    for (const auto& light : s.punctualLights) spots += light.type == bb::PunctualLight::Type::Spot;
+    for (const auto& m : s.materials) cutouts += m.alphaMask;
+    std::printf("lights       %zu directional, %zu point, %zu spot\n", s.lights.size(), s.punctualLights.size() - spots,
+                spots);
     for (const auto& light : s.lights)
         std::printf("             %s: direction (%.3f, %.3f, %.3f), irradiance (%.3g, %.3g, %.3g)\n", light.name.c_str(),
                     light.direction.x, light.direction.y, light.direction.z, light.irradiance.r, light.irradiance.g,
                     light.irradiance.b);
+    for (const auto& light : s.punctualLights)
+        std::printf("             %s: %s at (%.4g, %.4g, %.4g), intensity (%.3g, %.3g, %.3g) cd, range %s\n",
+                    light.name.c_str(), light.type == bb::PunctualLight::Type::Spot ? "spot" : "point", light.position.x,
+                    light.position.y, light.position.z, light.intensity.r, light.intensity.g, light.intensity.b,
+                    light.range > 0 ? std::to_string(light.range).c_str() : "infinite");
+    if (cutouts) std::printf("cut-outs     %zu material(s) with alphaMode MASK\n", cutouts);
     std::printf("cameras      %zu\n", s.cameras.size());
     std::printf("textures     %zu\n", s.textures.size());
     std::printf("bounds       min (%.4g, %.4g, %.4g) max (%.4g, %.4g, %.4g) size (%.4g, %.4g, %.4g) scene units\n",
