@@ -7,6 +7,8 @@
 //   checkpoint.cpp      checkpoints
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -38,7 +40,8 @@ struct Baker::Impl {
     int maxTileSize = 2048;   // largest head image side the budget allows
     float depthBias = 0.0f;
     double historyPower = 0.0;
-    double accumScale = 1.0;  // stored sums are true sums / accumScale
+    double accumLogScale = 0.0;  // stored weights are true weights / exp(accumLogScale)
+    int refreshEveryRound = 64;  // rounds refreshed after each one before the schedule thins out (bounces)
     float radianceUnit = 1.0f;  // the light-map state holds radiance / radianceUnit (sanitizeInputs)
     std::vector<double> projectedArea;  // per triangle world area
     std::vector<Cluster> clusters;      // the mesh in culling units (engine/tiler)
@@ -115,6 +118,15 @@ struct Baker::Impl {
     int shareIndex() const { return options.share ? options.share->index() : 0; }
     int shareCount() const { return options.share ? options.share->count() : 1; }
     int rounds() const { return (options.directions + shareCount() - 1) / shareCount(); }
+    // ln of round j's weight in the history ramp, min(j+1, rounds/2)^historyPower (in logs: powers up to 256)
+    double rampLogWeight(int round) const {
+        return historyPower * std::log(std::min(double(round + 1), double(std::max(1, rounds() / 2))));
+    }
+    // Rounds between radiance refreshes after round j: 1 while bounces are
+    // still needed (refreshEveryRound), then one more every 32 rounds, at most 8.
+    int refreshInterval(int round) const {
+        return std::clamp((round - std::max(0, refreshEveryRound - 64)) / 32, 1, 8);
+    }
     void noteMemory();  // peaks into stats
     // The outgoing radiance the bundles read: meta.frag over every page, then the padding.
     void refreshRadiance(uint32_t key);  // key: the direction just done (random numbers)

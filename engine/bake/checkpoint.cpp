@@ -90,7 +90,7 @@ struct CheckpointHeader {
     int32_t resolution;
     int32_t pages;
     int32_t pad;
-    double accumScale;
+    double accumLogScale;
 };
 }  // namespace
 
@@ -148,7 +148,7 @@ Status Baker::saveCheckpoint(const std::string& path) {
     h.directionsDone = m.stats.directionsDone;
     h.resolution = res;
     h.pages = m.layout.pageCount;
-    h.accumScale = m.accumScale;
+    h.accumLogScale = m.accumLogScale;
     // the radiance map too: it is refreshed on a schedule, so it can be older than the accumulators
     std::vector<uint32_t> radiance(raw.size());  // RGB9E5 bits
     gl::readTexture(m.radianceBits.id(), 0, 0, 0, res, res, pages, GL_RED_INTEGER, GL_UNSIGNED_INT, 4, radiance.data());
@@ -196,7 +196,7 @@ Status Baker::loadCheckpoint(const std::string& path) {
         fileBytes - mapBytes - sizeof countersBytes != countersBytes)
         return refuse(std::to_string(fileBytes) + " bytes, which is not this layout's light maps (" +
                       std::to_string(mapBytes) + " bytes) and their statistics");
-    if (!(std::isfinite(h.accumScale) && h.accumScale > 0.0)) return refuse("corrupt accumulator scale");
+    if (!std::isfinite(h.accumLogScale)) return refuse("corrupt accumulator scale");
     std::vector<glm::uvec2> raw(texels);
     std::vector<uint32_t> radiance(texels);
     const bool ok = std::fseek(f, long(sizeof h), SEEK_SET) == 0 &&
@@ -224,7 +224,7 @@ Status Baker::loadCheckpoint(const std::string& path) {
                      radiance.data());
     m.stats = restored;
     m.stats.directionsDone = h.directionsDone;
-    m.accumScale = h.accumScale;
+    m.accumLogScale = h.accumLogScale;
     if (m.shareIndex() > 0) {  // the sums are baker 0's to hold
         const GLuint zero[4] = {0, 0, 0, 0};
         glClearTexImage(m.accum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, zero);

@@ -23,17 +23,16 @@ void Baker::Impl::beginDirection(int k) {
     const glm::vec3 d = directions[size_t(k)];
     // history ramp: weight min(j+1, rounds/2)^power relative to the stored
     // scale, j the round (the direction, baked alone): a round adds a bounce
-    const double rampEnd = std::max(1, rounds() / 2);
-    const double weight = std::pow(std::min(double(k / shareCount() + 1), rampEnd), historyPower);
-    double sampleWeight = weight / accumScale;
+    const double logWeight = rampLogWeight(k / shareCount());
+    double sampleWeight = std::exp(logWeight - accumLogScale);
     if (sampleWeight > 16.0) {
         gl::DebugGroup group("rescale accumulators");
         glUseProgram(rescaleProgram.id());
-        glUniform1f(rescaleProgram.uniform("factor"), float(accumScale / weight));
+        glUniform1f(rescaleProgram.uniform("factor"), float(std::exp(accumLogScale - logWeight)));
         glUniform1ui(rescaleProgram.uniform("randomSeed"), pcgHash(uint32_t(options.seed) ^ pcgHash(uint32_t(k) + 77u)));
         glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
         dispatchPages(rescaleProgram.id());
-        accumScale = weight;
+        accumLogScale = logWeight;
         sampleWeight = 1.0;
     }
     const uint32_t seed = pcgHash(uint32_t(options.seed) * 0x9E3779B1u ^ pcgHash(uint32_t(k)));
@@ -72,10 +71,9 @@ void Baker::Impl::stepTile() {
 
 void Baker::Impl::finishRound(int round) {
     // Refresh the outgoing radiance the next bundles read. After every round
-    // at first, when each one adds a bounce; later every j/32 rounds (at most
-    // 8): the estimate then moves slowly and the refresh is a pass over every page.
-    const int interval = std::clamp(round / 32, 1, 8);
-    if ((round + 1) % interval == 0 || round + 1 == rounds()) {
+    // while each one adds a bounce the estimate needs; later every j/32 rounds
+    // (at most 8): the estimate then moves slowly and the refresh is a pass over every page.
+    if ((round + 1) % refreshInterval(round) == 0 || round + 1 == rounds()) {
         auto tr = Clock::now();
         combineShares(round);
         stats.secondsCombine += secondsSince(tr);
@@ -109,9 +107,9 @@ void Baker::Impl::combineShares(int round) {
         }
     }
     // Sums relative to the round's ramp weight, which every baker knows (each
-    // one's accumScale follows its own rescales): weights W and W x mean.
-    const double scale = std::pow(std::min(double(round + 1), double(std::max(1, rounds() / 2))), historyPower);
-    const float toCommon = float(accumScale / scale);
+    // one's accumLogScale follows its own rescales): weights W and W x mean.
+    const double logScale = rampLogWeight(round);
+    const float toCommon = float(std::exp(accumLogScale - logScale));
     const auto rnd = [this, round](size_t texel, uint32_t channel) {
         return uniform01(pcgHash(uint32_t(options.seed) ^ pcgHash(uint32_t(texel) * 4u + channel) ^
                                  pcgHash(uint32_t(round) + 0x68e31da4u)));
@@ -144,7 +142,7 @@ void Baker::Impl::combineShares(int round) {
         }
         gl::writeTexture(accum.id(), 0, 0, p, res, res, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
     }
-    accumScale = scale;
+    accumLogScale = logScale;
     ++stats.combines;
 }
 
