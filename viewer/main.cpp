@@ -426,6 +426,9 @@ void Viewer::drawPanel() {
         else
             ImGui::Text("%.2f directions/s, ETA %s%s", directionsPerSecond_, paused_ ? "- (paused)" : duration(eta).c_str(),
                         "");
+        // the bake's own estimate (engine/bake/noise.cpp), from the latest radiance refresh
+        if (baker_->stats().noiseRelative >= 0)
+            ImGui::Text("noise %.2f %% (relative RMS, estimated)", 100.0 * baker_->stats().noiseRelative);
         ImGui::Text("%.1f ms per tile, %.1f s baking", tileSeconds_ * 1e3, bakeSeconds_);
         if (ImGui::Button(paused_ ? "Resume" : "Pause")) paused_ = !paused_;
         ImGui::SameLine();

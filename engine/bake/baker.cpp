@@ -4,6 +4,7 @@
 #include "bake/baker.h"
 
 #include <algorithm>
+#include <bit>
 #include <cstring>
 #include <cmath>
 #include <numeric>
@@ -106,6 +107,8 @@ nlohmann::json BakeStats::toJson() const {
     j["seconds"] = {{"setup", secondsSetup}, {"importance", secondsImportance}, {"tiling", secondsTiling}, {"sun", secondsSun}, {"emitters", secondsEmitters}, {"bundle", secondsBundle}, {"update", secondsUpdate},
                     {"resolve", secondsResolve}, {"combine", secondsCombine}, {"total", secondsTotal()}};
     if (combines > 0) j["combine"] = {{"count", combines}, {"bytes_sent", combineBytes}};
+    j["noise"] = {{"relative", noiseRelative}, {"sampled_texels", noiseTexels}, {"stride", noiseStride},
+                  {"stopped_at_target", stoppedAtTargetNoise}, {"history", noiseHistory}};
     return j;
 }
 
@@ -120,6 +123,7 @@ Status Baker::Impl::buildPrograms() {
         {&sunProgram, {"lightmap/update.vert", "lightmap/update.frag"}, "#define SUN_PASS 1\n"},
         {&resolveProgram, {"lightmap/resolve.comp"}, ""},
         {&rescaleProgram, {"lightmap/rescale.comp"}, rounding},
+        {&noiseProgram, {"lightmap/noise.comp"}, ""},
         {&metaProgram, {"lightmap/meta.vert", "lightmap/meta.frag"}, rounding},
         {&coverageProgram, {"lightmap/meta.vert", "lightmap/meta.frag"}, "#define COVERAGE 1\n"},
         {&dilateProgram, {"lightmap/dilate.comp"}, ""},
@@ -149,6 +153,19 @@ void Baker::Impl::dispatchPages(GLuint program) {
     glUniform1i(glGetUniformLocation(program, "pageCount"), layout.pageCount);
     glUniform2i(glGetUniformLocation(program, "pageSize"), layout.resolution, layout.resolution);
     glDispatchCompute((layout.resolution + 7) / 8, (layout.resolution + 7) / 8, layout.pageCount);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+}
+
+void Baker::Impl::rescaleAccumulators(float factor, uint32_t seed) {
+    gl::DebugGroup group("rescale accumulators");
+    glUseProgram(rescaleProgram.id());
+    glUniform1f(rescaleProgram.uniform("factor"), factor);
+    glUniform1ui(rescaleProgram.uniform("randomSeed"), seed);
+    glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
+    dispatchPages(rescaleProgram.id());
+    glBindImageTexture(BINDING_ACCUM, halfAccum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
+    glUniform2i(rescaleProgram.uniform("pageSize"), halfWidth, halfWidth);
+    glDispatchCompute(GLuint(halfWidth + 7) / 8, GLuint(halfWidth + 7) / 8, GLuint(layout.pageCount));
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
 }
 
@@ -405,10 +422,19 @@ Status Baker::Impl::init(const Scene& scene) {
         radianceAsFloat = gl::Texture::createView("outgoing radiance as r32f (direct light sums)", radiance, GL_R32F);
     }
     stats.lightmapStateBytes = accum.bytes() + radiance.bytes() + direct.bytes() + dilation.bytes();
+    {
+        // the noise estimate's half: about 256^2 sampled texels a page, every texel of small pages
+        MemoryCategory category("noise estimate");
+        stats.noiseStride = std::clamp(int(std::bit_floor(unsigned(std::max(1, res / 256)))), 1, 16);
+        halfWidth = (res + stats.noiseStride - 1) / stats.noiseStride;
+        halfAccum = gl::Texture::create2DArray("noise estimate: odd directions' accumulators", GL_RG32UI, halfWidth,
+                                               halfWidth, pages);
+    }
     glTextureParameteri(radiance.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     glTextureParameteri(radiance.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     const uint32_t zero[4] = {0, 0, 0, 0};
     glClearTexImage(accum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, zero);
+    glClearTexImage(halfAccum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, zero);
     glClearTexImage(radianceBits.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, zero);
     glClearTexImage(direct.id(), 0, GL_RGBA, GL_FLOAT, zero);
     pageFbo = gl::Framebuffer::create("light map page framebuffer (no attachments)");
@@ -550,7 +576,7 @@ void Baker::Impl::stepDirection() {
 
 void Baker::Impl::run(double seconds, bool wholeDirections) {
     auto t0 = Clock::now();
-    while (stats.directionsDone < options.directions) {
+    while (stats.directionsDone < directionsGoal()) {
         if (wholeDirections)
             stepDirection();
         else
@@ -578,7 +604,7 @@ BakeProgress Baker::stepTiles(double seconds) {
 }
 
 BakeProgress Baker::progress() const {
-    return {impl_->stats.directionsDone, impl_->options.directions, impl_->directionActive, impl_->combined};
+    return {impl_->stats.directionsDone, impl_->directionsGoal(), impl_->directionActive, impl_->combined};
 }
 
 LightmapPages Baker::readLightmaps() {

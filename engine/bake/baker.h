@@ -76,6 +76,9 @@ struct BakeOptions {
     // this one bakes every count()-th direction and combines accumulators with
     // the others at each refresh. Null: the bake is this baker's alone.
     std::shared_ptr<DirectionShare> share;
+    // > 0: stop once the estimated relative noise of the light maps is at most
+    // this (checked at radiance refreshes, from 16 directions on); `directions` is then the most
+    double targetNoise = 0;
 };
 
 // Figures every bake reports (stats.json).
@@ -119,6 +122,13 @@ struct BakeStats {
     int64_t combines = 0;
     int64_t combineBytes = 0;
     double secondsCombine = 0;        // all of it, including the share's waiting and transfer
+    // The noise estimate (noise.cpp): RMS of the light map's standard deviation
+    // over its mean, from the odd and even directions' halves at sampled texels
+    double noiseRelative = -1;        // < 0: not yet estimated
+    int noiseStride = 1;              // every noiseStride-th texel of each axis is sampled
+    int64_t noiseTexels = 0;          // sampled texels the last estimate used
+    std::vector<std::pair<int, double>> noiseHistory;  // (directions done, relative noise) at refreshes
+    bool stoppedAtTargetNoise = false;
     double secondsTotal() const {
         return secondsSetup + secondsSun + secondsEmitters + secondsTiling + secondsBundle + secondsUpdate +
                secondsResolve + secondsCombine;

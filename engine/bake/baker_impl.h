@@ -61,10 +61,14 @@ struct Baker::Impl {
     gl::Texture accum, radiance, direct, dilation;
     gl::Texture accumAsFloat, radianceBits, radianceAsFloat;  // views: rg32f, r32ui, r32f
     gl::Texture resolved;  // the whole light map L_lm, made on first use (the viewer's)
+    // the noise estimate (noise.cpp): the odd directions' accumulators at every
+    // noiseStride-th texel (8 bytes / stride^2 a page texel; its own memory category)
+    gl::Texture halfAccum;
+    int halfWidth = 1;     // halfAccum's side: ceil(resolution / stride)
     gl::Texture envTexture;
     gl::Framebuffer pageFbo;
     gl::Program updateProgram, sunProgram, resolveProgram, rescaleProgram, metaProgram, coverageProgram,
-        dilateProgram, directFoldProgram, distanceProgram, emitterProgram, punctualProgram;
+        dilateProgram, directFoldProgram, distanceProgram, emitterProgram, punctualProgram, noiseProgram;
     gl::Buffer materialAlphaBuffer, alphaTexelBuffer;  // cut-outs (glsl/shared/material_layout.h; cutouts.cpp)
     std::vector<glm::vec3> textureMeans;  // mean linear RGB of each scene texture (explicit emitters)
     std::vector<gl::Texture> materialTextures;
@@ -81,7 +85,8 @@ struct Baker::Impl {
     BundleTracer::UpdateFn directionUpdate;
     // shared bakes: the accumulators hold the combined sums (baker 0) or nothing (the others)
     bool combined = true;
-    std::vector<std::vector<uint32_t>> coveredTexelIndex;  // per page, the covered texels (combines)
+    std::vector<std::vector<uint32_t>> coveredTexelIndex;      // per page, the covered texels (combines)
+    std::vector<std::vector<uint32_t>> halfCoveredTexelIndex;  // per page, halfAccum's texels on covered ones
 
     Status init(const Scene& scene);
     static uint64_t hashInputs(const Scene& scene);  // inputKey (checkpoint.cpp)
@@ -133,6 +138,12 @@ struct Baker::Impl {
     // L_lm of the region (x 0.., y0.., page) + (width, rows, pages) into `target` at (0, 0, 0).
     void resolveInto(const gl::Texture& target, int y0, int rows, int page0, int pages);
     void dispatchPages(GLuint program);
+    // The accumulators' weights times `factor` (both the whole's and the noise half's).
+    void rescaleAccumulators(float factor, uint32_t seed);
+    // noise.cpp: the relative noise now (stats.noiseRelative), kept in the
+    // history; stops the bake (directionsGoal) when --target-noise is reached
+    void estimateNoise();
+    int directionsGoal() const { return stats.stoppedAtTargetNoise ? stats.directionsDone : options.directions; }
 };
 
 }  // namespace bb

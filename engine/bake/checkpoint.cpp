@@ -51,6 +51,7 @@ nlohmann::json statsCounters(const BakeStats& s) {
             {"bundle_triangles_drawn", s.bundleTrianglesDrawn}, {"update_triangles_drawn", s.updateTrianglesDrawn},
             {"seconds", {s.secondsTiling, s.secondsBundle, s.secondsUpdate, s.secondsResolve}},
             {"combines", {s.combines, s.combineBytes, s.secondsCombine}},
+            {"noise", {s.noiseRelative, s.noiseTexels}}, {"noise_history", s.noiseHistory},
             {"predicted_over_actual", s.predictedOverActual}, {"tiles_per_direction", s.tilesPerDirection},
             {"leaves_per_direction", s.leavesPerDirection}, {"tile_pixel_sizes", s.tilePixelSizes}};
 }
@@ -73,6 +74,9 @@ bool restoreStatsCounters(const nlohmann::json& j, BakeStats& s) {
         s.combines = c.at(0);
         s.combineBytes = c.at(1);
         s.secondsCombine = c.at(2);
+        s.noiseRelative = j.at("noise").at(0);
+        s.noiseTexels = j.at("noise").at(1);
+        s.noiseHistory = j.at("noise_history").get<std::vector<std::pair<int, double>>>();
         s.predictedOverActual = j.at("predicted_over_actual").get<std::vector<double>>();
         s.tilesPerDirection = j.at("tiles_per_direction").get<std::vector<int>>();
         s.leavesPerDirection = j.at("leaves_per_direction").get<std::vector<int>>();
@@ -152,9 +156,13 @@ Status Baker::saveCheckpoint(const std::string& path) {
     // the radiance map too: it is refreshed on a schedule, so it can be older than the accumulators
     std::vector<uint32_t> radiance(raw.size());  // RGB9E5 bits
     gl::readTexture(m.radianceBits.id(), 0, 0, 0, res, res, pages, GL_RED_INTEGER, GL_UNSIGNED_INT, 4, radiance.data());
+    // and the noise estimate's half
+    std::vector<glm::uvec2> half(size_t(m.halfWidth) * m.halfWidth * pages);
+    gl::readTexture(m.halfAccum.id(), 0, 0, 0, m.halfWidth, m.halfWidth, pages, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, half.data());
     std::string bytes(reinterpret_cast<const char*>(&h), sizeof h);
     bytes.append(reinterpret_cast<const char*>(raw.data()), raw.size() * sizeof(glm::uvec2));
     bytes.append(reinterpret_cast<const char*>(radiance.data()), radiance.size() * sizeof(uint32_t));
+    bytes.append(reinterpret_cast<const char*>(half.data()), half.size() * sizeof(glm::uvec2));
     // then the statistics so far (JSON, length first: doubles round-trip exactly;
     // a shared bake's: an array, one per baker)
     const uint64_t countersBytes = counters.size();
@@ -172,7 +180,8 @@ Status Baker::loadCheckpoint(const std::string& path) {
     CheckpointHeader h{};
     const int res = m.layout.resolution;
     const size_t texels = size_t(res) * res * m.layout.pageCount;
-    const size_t mapBytes = sizeof h + texels * (sizeof(glm::uvec2) + sizeof(uint32_t));
+    const size_t halfTexels = size_t(m.halfWidth) * m.halfWidth * m.layout.pageCount;
+    const size_t mapBytes = sizeof h + texels * (sizeof(glm::uvec2) + sizeof(uint32_t)) + halfTexels * sizeof(glm::uvec2);
     // every way a file can fail to be this layout's checkpoint, said before anything is read into GL
     const bool headerRead = std::fread(&h, sizeof h, 1, f) == 1;
     size_t fileBytes = 0;
@@ -199,9 +208,11 @@ Status Baker::loadCheckpoint(const std::string& path) {
     if (!std::isfinite(h.accumLogScale)) return refuse("corrupt accumulator scale");
     std::vector<glm::uvec2> raw(texels);
     std::vector<uint32_t> radiance(texels);
+    std::vector<glm::uvec2> half(halfTexels);
     const bool ok = std::fseek(f, long(sizeof h), SEEK_SET) == 0 &&
                     std::fread(raw.data(), sizeof(glm::uvec2), raw.size(), f) == raw.size() &&
-                    std::fread(radiance.data(), sizeof(uint32_t), radiance.size(), f) == radiance.size();
+                    std::fread(radiance.data(), sizeof(uint32_t), radiance.size(), f) == radiance.size() &&
+                    std::fread(half.data(), sizeof(glm::uvec2), half.size(), f) == half.size();
     std::string counters(countersBytes, '\0');
     const bool countersRead = ok && std::fseek(f, long(mapBytes + sizeof countersBytes), SEEK_SET) == 0 &&
                               std::fread(counters.data(), 1, counters.size(), f) == counters.size();
@@ -222,12 +233,15 @@ Status Baker::loadCheckpoint(const std::string& path) {
     gl::writeTexture(m.accum.id(), 0, 0, 0, res, res, m.layout.pageCount, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
     gl::writeTexture(m.radianceBits.id(), 0, 0, 0, res, res, m.layout.pageCount, GL_RED_INTEGER, GL_UNSIGNED_INT, 4,
                      radiance.data());
+    gl::writeTexture(m.halfAccum.id(), 0, 0, 0, m.halfWidth, m.halfWidth, m.layout.pageCount, GL_RG_INTEGER,
+                     GL_UNSIGNED_INT, 8, half.data());
     m.stats = restored;
     m.stats.directionsDone = h.directionsDone;
     m.accumLogScale = h.accumLogScale;
     if (m.shareIndex() > 0) {  // the sums are baker 0's to hold
         const GLuint zero[4] = {0, 0, 0, 0};
         glClearTexImage(m.accum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, zero);
+        glClearTexImage(m.halfAccum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, zero);
     }
     m.combined = true;
     return Status::ok();

@@ -1,5 +1,6 @@
-// Bundle directions: spherical Fibonacci over the hemisphere z > 0, a seeded
-// uniform random rotation, and a van der Corput order so prefixes stay spread.
+// Bundle directions: two spherical Fibonacci sets over the hemisphere z > 0,
+// each with a seeded uniform random rotation and a van der Corput order so
+// prefixes stay spread, interleaved (bake/directions.h).
 //
 // Based on: Marques, Bouville, Ribardiere, Santos, Bouatouch, "Spherical
 // Fibonacci Point Sets for Illumination Integrals", CGF 32(8), 2013 (the set);
@@ -60,29 +61,27 @@ glm::dmat3 randomRotation(uint64_t seed) {
 
 }  // namespace
 
-std::vector<glm::vec3> makeDirections(int count, uint64_t seed) {
-    CHECK_GE(count, 1);
-    const size_t n = size_t(count);
-    const glm::dmat3 rotation = randomRotation(seed);
+namespace {
+// One spherical Fibonacci set of `count` points over the hemisphere, rotated,
+// in van der Corput order.
+std::vector<glm::vec3> fibonacciSet(size_t count, const glm::dmat3& rotation) {
     const double goldenFraction = (std::sqrt(5.0) - 1.0) / 2.0;  // 1/phi
-
     // order: Fibonacci index j_i = floor(radicalInverse2(k) * count) for
     // k = 0, 1, 2, ..., skipping indices already taken. Once 2^m >= count the
     // first 2^m values of k hit every j, so this ends by k < 2 * count. Any
     // aligned run of 2^m outputs is then one point per 1/2^m band of z.
     std::vector<uint32_t> order;
-    order.reserve(n);
-    std::vector<bool> taken(n, false);
-    for (uint32_t k = 0; order.size() < n; ++k) {
+    order.reserve(count);
+    std::vector<bool> taken(count, false);
+    for (uint32_t k = 0; order.size() < count; ++k) {
         // floor(radicalInverse2(k) * count) in exact integer arithmetic
         const size_t j = size_t((uint64_t(reverseBits(k)) * uint64_t(count)) >> 32);
         if (taken[j]) continue;
         taken[j] = true;
         order.push_back(uint32_t(j));
     }
-
     std::vector<glm::vec3> directions;
-    directions.reserve(n);
+    directions.reserve(count);
     for (uint32_t j : order) {
         // spherical Fibonacci point j: equal-area bands in z, golden-ratio azimuths
         const double z = 1.0 - (double(j) + 0.5) / double(count);
@@ -93,6 +92,18 @@ std::vector<glm::vec3> makeDirections(int count, uint64_t seed) {
         const glm::dvec3 d = rotation * glm::dvec3(r * std::cos(phi), r * std::sin(phi), z);
         directions.push_back(glm::vec3(glm::normalize(d)));
     }
+    return directions;
+}
+}  // namespace
+
+std::vector<glm::vec3> makeDirections(int count, uint64_t seed) {
+    CHECK_GE(count, 1);
+    // two independently rotated sets, interleaved (replicates)
+    const std::vector<glm::vec3> even = fibonacciSet(size_t(count + 1) / 2, randomRotation(seed));
+    const std::vector<glm::vec3> odd = fibonacciSet(size_t(count) / 2, randomRotation(seed ^ 0x5851F42D4C957F2Dull));
+    std::vector<glm::vec3> directions;
+    directions.reserve(size_t(count));
+    for (size_t k = 0; k < size_t(count); ++k) directions.push_back(k % 2 == 0 ? even[k / 2] : odd[k / 2]);
     return directions;
 }
 

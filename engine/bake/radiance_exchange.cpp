@@ -26,17 +26,12 @@ void Baker::Impl::beginDirection(int k) {
     const double logWeight = rampLogWeight(k / shareCount());
     double sampleWeight = std::exp(logWeight - accumLogScale);
     if (sampleWeight > 16.0) {
-        gl::DebugGroup group("rescale accumulators");
-        glUseProgram(rescaleProgram.id());
-        glUniform1f(rescaleProgram.uniform("factor"), float(std::exp(accumLogScale - logWeight)));
-        glUniform1ui(rescaleProgram.uniform("randomSeed"), pcgHash(uint32_t(options.seed) ^ pcgHash(uint32_t(k) + 77u)));
-        glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
-        dispatchPages(rescaleProgram.id());
+        rescaleAccumulators(float(std::exp(accumLogScale - logWeight)), pcgHash(uint32_t(options.seed) ^ pcgHash(uint32_t(k) + 77u)));
         accumLogScale = logWeight;
         sampleWeight = 1.0;
     }
     const uint32_t seed = pcgHash(uint32_t(options.seed) * 0x9E3779B1u ^ pcgHash(uint32_t(k)));
-    directionUpdate = [this, sampleWeight, seed](const TileFrame&, uint32_t) -> GLuint {
+    directionUpdate = [this, sampleWeight, seed, k](const TileFrame&, uint32_t) -> GLuint {
         const bool useEnv = bool(envTexture);
         glUseProgram(updateProgram.id());
         glUniform1f(updateProgram.uniform("sampleWeight"), float(sampleWeight));
@@ -45,6 +40,11 @@ void Baker::Impl::beginDirection(int k) {
         const glm::vec3 sky = options.sky / radianceUnit;
         glUniform3fv(updateProgram.uniform("sky"), 1, &sky.x);
         glUniform1i(updateProgram.uniform("useEnv"), useEnv);
+        // the noise estimate's halves: the odd directions are the second of the
+        // two independently rotated sets (bake/directions.h)
+        glUniform1i(updateProgram.uniform("oddDirection"), k % 2);
+        glUniform1i(updateProgram.uniform("halfStride"), stats.noiseStride);
+        glBindImageTexture(BINDING_HALF_ACCUM, halfAccum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
         glUniform1f(updateProgram.uniform("depthBias"), depthBias);
         if (useEnv) glBindTextureUnit(BINDING_ENV, envTexture.id());
         glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
@@ -79,9 +79,12 @@ void Baker::Impl::finishRound(int round) {
         stats.secondsCombine += secondsSince(tr);
         tr = Clock::now();
         refreshRadiance(uint32_t(round));
+        stats.directionsDone = std::min(options.directions, (round + 1) * shareCount());
+        estimateNoise();  // on the combined sums: every baker stops at the same round
         if (shareIndex() > 0) {  // what this baker adds from now on, alone: baker 0 holds the sums
             const GLuint zero[4] = {0, 0, 0, 0};
             glClearTexImage(accum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, zero);
+            glClearTexImage(halfAccum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, zero);
         }
         glFinish();
         stats.secondsResolve += secondsSince(tr);
@@ -95,53 +98,66 @@ void Baker::Impl::combineShares(int round) {
     gl::DebugGroup group("combine accumulators");
     DirectionShare& share = *options.share;
     const int res = layout.resolution;
-    const size_t pageTexels = size_t(res) * res;
-    std::vector<glm::uvec2> raw(pageTexels);
     if (coveredTexelIndex.empty()) {  // the texels the update pass writes: the others hold nothing to combine
-        std::vector<uint8_t> codes(pageTexels);
+        std::vector<uint8_t> codes(size_t(res) * res);
         coveredTexelIndex.resize(size_t(layout.pageCount));
+        halfCoveredTexelIndex.resize(size_t(layout.pageCount));
+        const int stride = stats.noiseStride;
         for (int p = 0; p < layout.pageCount; ++p) {
             gl::readTexture(dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, codes.data());
-            for (size_t i = 0; i < pageTexels; ++i)
-                if (codes[i] == DILATION_SELF) coveredTexelIndex[size_t(p)].push_back(uint32_t(i));
+            for (int y = 0; y < res; ++y)
+                for (int x = 0; x < res; ++x) {
+                    if (codes[size_t(y) * res + x] != DILATION_SELF) continue;
+                    coveredTexelIndex[size_t(p)].push_back(uint32_t(y * res + x));
+                    if (x % stride == 0 && y % stride == 0)
+                        halfCoveredTexelIndex[size_t(p)].push_back(uint32_t(y / stride * halfWidth + x / stride));
+                }
         }
     }
     // Sums relative to the round's ramp weight, which every baker knows (each
     // one's accumLogScale follows its own rescales): weights W and W x mean.
     const double logScale = rampLogWeight(round);
     const float toCommon = float(std::exp(accumLogScale - logScale));
-    const auto rnd = [this, round](size_t texel, uint32_t channel) {
-        return uniform01(pcgHash(uint32_t(options.seed) ^ pcgHash(uint32_t(texel) * 4u + channel) ^
-                                 pcgHash(uint32_t(round) + 0x68e31da4u)));
+    // the whole's accumulators, then the noise estimate's half
+    const auto combine = [&](const gl::Texture& texture, int width, const std::vector<std::vector<uint32_t>>& coveredIndex,
+                             uint32_t salt) {
+        const size_t pageTexels = size_t(width) * width;
+        const auto rnd = [&](size_t texel, uint32_t channel) {
+            return uniform01(pcgHash(uint32_t(options.seed) ^ pcgHash(uint32_t(texel) * 4u + channel) ^
+                                     pcgHash(uint32_t(round) + salt)));
+        };
+        std::vector<glm::uvec2> raw(pageTexels);
+        std::vector<float> sums;
+        for (int p = 0; p < layout.pageCount; ++p) {
+            const std::vector<uint32_t>& covered = coveredIndex[size_t(p)];
+            gl::readTexture(texture.id(), 0, 0, p, width, width, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
+            sums.assign(covered.size() * 4, 0.0f);
+            for (size_t i = 0; i < covered.size(); ++i) {
+                const glm::uvec2 v = raw[covered[i]];
+                const float w = halfToFloat(uint16_t(v.y >> 16)) * toCommon;
+                sums[4 * i + 0] = halfToFloat(uint16_t(v.x & 0xFFFF)) * w;
+                sums[4 * i + 1] = halfToFloat(uint16_t(v.x >> 16)) * w;
+                sums[4 * i + 2] = halfToFloat(uint16_t(v.y & 0xFFFF)) * w;
+                sums[4 * i + 3] = w;
+            }
+            share.sum(sums.data(), sums.size());
+            stats.combineBytes += int64_t(sums.size() * sizeof(float));
+            // every baker stores the combined means (the outgoing pass reads them);
+            // the rounding's random numbers are the same on all, so are the bits
+            for (size_t i = 0; i < covered.size(); ++i) {
+                const float w = sums[4 * i + 3];
+                const glm::vec3 mean = w > 0.0f ? glm::vec3(sums[4 * i], sums[4 * i + 1], sums[4 * i + 2]) / w : glm::vec3(0.0f);
+                const size_t texel = size_t(p) * pageTexels + covered[i];
+                uint16_t h[4];
+                for (uint32_t c = 0; c < 3; ++c) h[c] = floatToHalf(mean[int(c)], options.rounding, rnd(texel, c));
+                h[3] = floatToHalf(w, options.rounding, rnd(texel, 3));
+                raw[covered[i]] = glm::uvec2(h[0] | uint32_t(h[1]) << 16, h[2] | uint32_t(h[3]) << 16);
+            }
+            gl::writeTexture(texture.id(), 0, 0, p, width, width, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
+        }
     };
-    std::vector<float> sums;
-    for (int p = 0; p < layout.pageCount; ++p) {
-        const std::vector<uint32_t>& covered = coveredTexelIndex[size_t(p)];
-        gl::readTexture(accum.id(), 0, 0, p, res, res, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
-        sums.assign(covered.size() * 4, 0.0f);
-        for (size_t i = 0; i < covered.size(); ++i) {
-            const glm::uvec2 v = raw[covered[i]];
-            const float w = halfToFloat(uint16_t(v.y >> 16)) * toCommon;
-            sums[4 * i + 0] = halfToFloat(uint16_t(v.x & 0xFFFF)) * w;
-            sums[4 * i + 1] = halfToFloat(uint16_t(v.x >> 16)) * w;
-            sums[4 * i + 2] = halfToFloat(uint16_t(v.y & 0xFFFF)) * w;
-            sums[4 * i + 3] = w;
-        }
-        share.sum(sums.data(), sums.size());
-        stats.combineBytes += int64_t(sums.size() * sizeof(float));
-        // every baker stores the combined means (the outgoing pass reads them);
-        // the rounding's random numbers are the same on all, so are the bits
-        for (size_t i = 0; i < covered.size(); ++i) {
-            const float w = sums[4 * i + 3];
-            const glm::vec3 mean = w > 0.0f ? glm::vec3(sums[4 * i], sums[4 * i + 1], sums[4 * i + 2]) / w : glm::vec3(0.0f);
-            const size_t texel = size_t(p) * pageTexels + covered[i];
-            uint16_t h[4];
-            for (uint32_t c = 0; c < 3; ++c) h[c] = floatToHalf(mean[int(c)], options.rounding, rnd(texel, c));
-            h[3] = floatToHalf(w, options.rounding, rnd(texel, 3));
-            raw[covered[i]] = glm::uvec2(h[0] | uint32_t(h[1]) << 16, h[2] | uint32_t(h[3]) << 16);
-        }
-        gl::writeTexture(accum.id(), 0, 0, p, res, res, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
-    }
+    combine(accum, res, coveredTexelIndex, 0x68e31da4u);
+    combine(halfAccum, halfWidth, halfCoveredTexelIndex, 0x2545f491u);
     accumLogScale = logScale;
     ++stats.combines;
 }

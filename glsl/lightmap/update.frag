@@ -41,6 +41,12 @@ uniform bool useEnv;
 uniform vec3 sky;
 uniform float sampleWeight;  // this direction's weight (history ramp), relative to the stored scale
 uniform uint randomSeed;
+// The noise estimate's half (engine/bake/noise.cpp): the odd directions' own
+// running mean (the second of the two direction sets, bake/directions.h),
+// kept at every halfStride-th texel of each axis.
+layout(binding = BINDING_HALF_ACCUM, rg32ui) uniform coherent uimage2DArray halfAccum;
+uniform bool oddDirection;
+uniform int halfStride;
 #endif
 uniform uint nodeCount;      // nodes in this tile's lists (END_OF_LIST is larger)
 uniform float depthBias;      // scene units: float precision floor
@@ -60,6 +66,20 @@ vec3 environment(vec3 dir) {
     return vec3(0.0);
 #endif
 }
+
+#ifndef SUN_PASS
+// `stored` (fp16 running mean M, weight W) with L_in folded in at weight w:
+// W += w, M += (L_in - M) w / W, rounded with the random numbers of h.
+uvec2 foldSample(uvec2 stored, vec3 incoming, float w, uint h) {
+    vec4 state = vec4(halfToFloat(stored.x), halfToFloat(stored.x >> 16u), halfToFloat(stored.y),
+                      halfToFloat(stored.y >> 16u));
+    float total = state.a + w;
+    vec4 sum = vec4(state.rgb + (incoming - state.rgb) * (w / total), total);
+    uint h1 = pcgHash(h), h2 = pcgHash(h1), h3 = pcgHash(h2);
+    return uvec2(floatToHalf(sum.r, uniform01(h)) | (floatToHalf(sum.g, uniform01(h1)) << 16u),
+                 floatToHalf(sum.b, uniform01(h2)) | (floatToHalf(sum.a, uniform01(h3)) << 16u));
+}
+#endif
 
 void main() {
     // the triangle's own plane, from screen derivatives (before any return:
@@ -162,17 +182,13 @@ void main() {
         bool visible = (nodes[bestNode].depth & seenSide) != 0u;
         incoming = visible ? decodeRgbe(nodes[bestNode].radiance) : vec3(0.0);  // a back face is black
     }
-    uvec2 stored = imageLoad(accum, texel).rg;
-    // stored: the running cosine-weighted mean of L_in (rgb) and its weight W (a)
-    vec4 state = vec4(halfToFloat(stored.x), halfToFloat(stored.x >> 16u), halfToFloat(stored.y),
-                      halfToFloat(stored.y >> 16u));
+    // the running cosine-weighted mean of L_in (rgb) and its weight W (a)
     float w = sampleWeight * cosine;
-    float total = state.a + w;
-    vec4 sum = vec4(state.rgb + (incoming - state.rgb) * (w / total), total);
     uint h = pcgHash(randomSeed ^ pcgHash(uint(texel.x) | (uint(texel.y) << 16u)) ^ pcgHash(vPage + 7919u));
-    uint h1 = pcgHash(h), h2 = pcgHash(h1), h3 = pcgHash(h2);
-    uvec2 result = uvec2(floatToHalf(sum.r, uniform01(h)) | (floatToHalf(sum.g, uniform01(h1)) << 16u),
-                         floatToHalf(sum.b, uniform01(h2)) | (floatToHalf(sum.a, uniform01(h3)) << 16u));
-    imageStore(accum, texel, uvec4(result, 0u, 0u));
+    imageStore(accum, texel, uvec4(foldSample(imageLoad(accum, texel).rg, incoming, w, h), 0u, 0u));
+    if (oddDirection && texel.x % halfStride == 0 && texel.y % halfStride == 0) {
+        ivec3 half_ = ivec3(texel.xy / halfStride, texel.z);
+        imageStore(halfAccum, half_, uvec4(foldSample(imageLoad(halfAccum, half_).rg, incoming, w, pcgHash(h ^ 0x9e3779b9u)), 0u, 0u));
+    }
 #endif
 }

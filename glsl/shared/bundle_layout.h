@@ -34,6 +34,8 @@ struct Node {
 #define BINDING_RADIANCE_BITS 5  // image unit: r32ui view of the radiance map (RGB9E5 bits), written by the outgoing pass
 #define BINDING_DILATION 6       // image unit: r8ui per texel: DILATION_SELF, the covered texel it copies, or DILATION_NONE
 #define BINDING_TARGET 7         // image unit: rgba32f light map L_lm (the resolve's output)
+#define BINDING_HALF_ACCUM 3     // image unit: rg32ui odd directions' accumulators at every halfStride-th texel
+                                 // (the noise estimate; unit 3 is the direct-light scratch only while that is baked)
 #define BINDING_RADIANCE 0       // texture unit: RGB9_E5 outgoing radiance Lo per texel, array of pages
 #define BINDING_ENV 1            // texture unit: environment map (equirectangular)
 #define BINDING_MATERIAL_TEX 2   // texture unit: a material's albedo texture (emission: + 1)

@@ -68,6 +68,11 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
     cmd.add_option("--emitter-samples", a.emitterSamples, "Visibility samples over all explicit emitters")
         ->check(CLI::Range(1, 1 << 16))
         ->capture_default_str();
+    cmd.add_option("--target-noise", a.targetNoise,
+                   "Stop once the estimated relative noise of the light maps is at most this (e.g. 0.01; checked at "
+                   "radiance refreshes from 16 directions on; --directions is then the most); 0 = off")
+        ->check(CLI::Range(0.0, 1.0))
+        ->capture_default_str();
     cmd.add_option("--checkpoint-every", a.checkpointEvery,
                    "Write OUTDIR/checkpoint.bin every N directions (0 = never)")
         ->check(CLI::NonNegativeNumber)
@@ -141,6 +146,7 @@ int runBake(const BakeArgs& args) {
                                                     : BakeOptions::DirectLight::Auto;
     options.emitterSamples = args.emitterSamples;
     options.share = mpi;
+    options.targetNoise = args.targetNoise;
     if (Status s = loadEnvironment(args.env, options.environment); !s) return fail(s.message());
     auto loaded = loadSceneAndLayout(args.scene);
     if (!loaded) return fail(loaded.error());
@@ -210,7 +216,7 @@ int runBake(const BakeArgs& args) {
                      {"uv_layout", args.scene.uvLayout}, {"resolution", args.scene.resolution},
                      {"texel_density", args.scene.texelDensity}, {"history_power", (*baker)->stats().historyPower},
                      {"direct", args.direct}, {"emitter_samples", args.emitterSamples},
-                     {"mpi_ranks", mpi ? mpi->count() : 1}};
+                     {"mpi_ranks", mpi ? mpi->count() : 1}, {"target_noise", args.targetNoise}};
     info.wallSeconds = seconds;
     info.writePreviews = args.preview;
     LightmapPages maps = (*baker)->readLightmaps();  // before the stats: its read-back memory counts
@@ -219,7 +225,7 @@ int runBake(const BakeArgs& args) {
     if (Status s = writeBakeOutputs(args.outDir, loaded->scene, loaded->layout, maps, stats, info); !s)
         return fail(s.message());
     if (args.checkpointEvery > 0 || args.resume) std::filesystem::remove(checkpoint);  // the outputs supersede it
-    logInfo("baked " + std::to_string(options.directions) + " directions in " + std::to_string(seconds) + " s -> " +
+    logInfo("baked " + std::to_string((*baker)->progress().directionsDone) + " directions in " + std::to_string(seconds) + " s -> " +
             args.outDir + (mpi ? " (" + std::to_string(mpi->count()) + " MPI ranks)" : ""));
     return 0;
 }

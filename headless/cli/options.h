@@ -44,6 +44,7 @@ struct BakeArgs {
     std::string env;
     int checkpointEvery = 0;
     bool resume = false;
+    double targetNoise = 0;           // > 0: stop at this estimated relative noise
     std::string rounding = "stochastic";
     float historyPower = -1.0f;
     std::string direct = "auto";

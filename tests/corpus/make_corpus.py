@@ -153,8 +153,11 @@ def main():
         d["accessors"][0]["sparse"] = {"count": 1, "indices": {"bufferView": n - 2, "componentType": 5125},
                                        "values": {"bufferView": n - 1}}
     write("gltf/sparse_index_out_of_range.gltf", triangle(extra=sparse))
-    # loads with a warning (no material), then the layout refuses it (no TEXCOORD_1): the error line alone
-    write("gltf/no_uv1_warning_first.gltf", triangle(extra=lambda d: (
+    # loads with a warning (no material), then the layout refuses it (no TEXCOORD_1, and the 400
+    # separate triangles' generated charts do not fit a 16^2 page): the error line alone
+    scattered = [c for i in range(400) for c in (3 * (i % 20), 3 * (i // 20), 0, 3 * (i % 20) + 1, 3 * (i // 20), 0,
+                                                 3 * (i % 20), 3 * (i // 20) + 1, 0)]
+    write("gltf/no_uv1_warning_first.gltf", triangle(positions=scattered, extra=lambda d: (
         d["meshes"][0]["primitives"][0].pop("material"), d["meshes"][0]["primitives"][0]["attributes"].pop("TEXCOORD_1"))))
     write("gltf/uv1_accessor_too_short.gltf", triangle(extra=lambda d: d["accessors"][1].update(count=2)))
     # --- glb ----------------------------------------------------------------
@@ -213,7 +216,7 @@ def main():
     # --- checkpoints (--resume) ---------------------------------------------
     def header(magic=b"BBCKPT05", key=0, done=1, res=16, pages=1, scale=1.0):
         return magic + struct.pack("<Qiiiid", key, done, res, pages, 0, scale)
-    maps = b"\0" * (16 * 16 * 12)                   # accumulators (8) + radiance (4) per texel
+    maps = b"\0" * (16 * 16 * 20)                   # accumulators (8) + radiance (4) + noise half (8) per texel
     stats = struct.pack("<Q", 2) + b"{}"             # the statistics block: length, JSON
     write("checkpoint/empty.bin", b"")
     write("checkpoint/garbage.bin", bytes((i * 101 + 7) % 256 for i in range(4096)))

@@ -37,9 +37,9 @@ struct Expect {
 TEST(CliInfo, DescribesEveryShippedScene) {
     const Expect cases[] = {
         {"assets/shared/cornell_box/CornellBox.glb", "triangles    36 ", "skipped      0 degenerate", "lights       0 ", "layout       pack, 1 page"},
-        {"assets/shared/living_room/living_room.glb", "triangles    1551 ", "skipped      3537 degenerate", "lights       0 ", "layout       none: "},
+        {"assets/shared/living_room/living_room.glb", "triangles    1551 ", "skipped      3537 degenerate", "lights       0 ", "layout       pack, 1 page"},
         {"assets/shared/mixed_lighting/MixedLightingExample.gltf", "triangles    40898 ", "skipped      0 degenerate", "lights       1 directional", "layout       pack, 1 page"},
-        {"assets/shared/zdm2/zdm2.glb", "triangles    57638 ", "skipped      1134 degenerate", "lights       0 ", "layout       none: "},
+        {"assets/shared/zdm2/zdm2.glb", "triangles    57638 ", "skipped      1134 degenerate", "lights       0 ", "layout       pack, 1 page"},
         {"assets/cornell_box/cornell_box.gltf", "triangles    32 ", "skipped      0 degenerate", "lights       0 ", "layout       pack, 1 page"},
         {"assets/furnace/furnace.gltf", "triangles    24 ", "skipped      0 degenerate", "lights       0 ", "layout       pack, 1 page"},
     };

@@ -587,8 +587,9 @@ TEST(ImportanceCli, BadInputIsOneLineAndNonZero) {
     CliRun r = runCli(test::sourcePath("assets/does_not_exist.gltf") + " -o " + ::testing::TempDir() + "/imp_bad");
     EXPECT_NE(r.status, 0);
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-    // zdm2 has no TEXCOORD_1: the layout refuses it with a hint
-    r = runCli(test::sourcePath("assets/shared/zdm2/zdm2.glb") + " -o " + ::testing::TempDir() + "/imp_zdm2");
+    // zdm2 has no TEXCOORD_1: the asset layout refuses it with a hint
+    r = runCli(test::sourcePath("assets/shared/zdm2/zdm2.glb") + " --uv-layout asset -o " + ::testing::TempDir() +
+               "/imp_zdm2");
     EXPECT_NE(r.status, 0);
     EXPECT_NE(r.err.find("TEXCOORD_1"), std::string::npos) << r.err;
 }

@@ -1,6 +1,7 @@
 // Bundle directions: unit, distinct, uniform as the set {+-d}, seeded and
-// deterministic, a rotated copy of one fixed set, and stratified in every
-// aligned run (so a bake stopped early is still well spread).
+// deterministic; even and odd directions each a rotated copy of one fixed set
+// (two independent replicates), each stratified in every aligned run (so a
+// bake stopped early is still well spread).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -110,16 +111,34 @@ TEST(Directions, SameSeedSameBitsOtherSeedOtherSet) {
     EXPECT_GT(largest, 0.1);
 }
 
-TEST(Directions, OtherSeedsAreRotationsOfOneOrderedSet) {
+// Every second direction from `first` (0 or 1): one of the two replicates.
+std::vector<glm::vec3> replicate(const std::vector<glm::vec3>& dirs, size_t first) {
+    std::vector<glm::vec3> out;
+    for (size_t i = first; i < dirs.size(); i += 2) out.push_back(dirs[i]);
+    return out;
+}
+
+TEST(Directions, EachReplicateIsARotationOfOneOrderedSetAndTheTwoAreIndependent) {
     // a rotation keeps every dot product, and the order does not depend on the seed
-    const std::vector<glm::vec3> a = makeDirections(64, 1);
+    const std::vector<glm::vec3> a = makeDirections(128, 1);
     for (uint64_t seed : {2ull, 1000ull, 0xFFFFFFFFFFFFFFFFull}) {
-        const std::vector<glm::vec3> b = makeDirections(64, seed);
-        for (size_t i = 0; i < a.size(); ++i) {
-            for (size_t j = 0; j < a.size(); ++j)
-                ASSERT_NEAR(glm::dot(a[i], a[j]), glm::dot(b[i], b[j]), 2e-6f) << i << " " << j;
+        const std::vector<glm::vec3> b = makeDirections(128, seed);
+        for (size_t r : {0u, 1u}) {
+            const std::vector<glm::vec3> ra = replicate(a, r), rb = replicate(b, r);
+            for (size_t i = 0; i < ra.size(); ++i)
+                for (size_t j = 0; j < ra.size(); ++j)
+                    ASSERT_NEAR(glm::dot(ra[i], ra[j]), glm::dot(rb[i], rb[j]), 2e-6f) << r << ": " << i << " " << j;
         }
     }
+    // the two replicates are the same set under two different rotations
+    const std::vector<glm::vec3> even = replicate(a, 0), odd = replicate(a, 1);
+    double largest = 0.0;
+    for (size_t i = 0; i < even.size(); ++i) {
+        for (size_t j = 0; j < even.size(); ++j)
+            ASSERT_NEAR(glm::dot(even[i], even[j]), glm::dot(odd[i], odd[j]), 2e-6f) << i << " " << j;
+        largest = std::max(largest, double(glm::length(even[i] - odd[i])));
+    }
+    EXPECT_GT(largest, 0.1);
 }
 
 // RMS over many axes a of |mean of the run folded onto a's hemisphere - a/2|:
@@ -147,20 +166,24 @@ TEST(Directions, EveryAlignedRunIsStratified) {
     // (folded mean). Measured worst ratios over 50 seeds: cosine 0.43, 0.53,
     // 0.35, 0.08 and folded mean 0.55, 0.65, 0.44, 0.26 for runs of 16, 32, 64,
     // 128; the van der Corput order stratifies z exactly, azimuth less so.
-    const std::vector<glm::vec3> dirs = makeDirections(256, 2024);
-    for (size_t run : {16u, 32u, 64u, 128u}) {
-        const double iidCosine = std::sqrt(1.0 / 12.0 / double(run));
-        const double iidFolded = std::sqrt(0.75 / double(run));
-        for (size_t begin = 0; begin < dirs.size(); begin += run) {
-            EXPECT_LT(rmsCosineError(dirs, begin, begin + run), 0.65 * iidCosine)
-                << "run [" << begin << ", " << begin + run << ")";
-            EXPECT_LT(rmsFoldedMeanError(dirs, begin, begin + run), 0.8 * iidFolded)
-                << "run [" << begin << ", " << begin + run << ")";
+    // (each replicate: a 256-set of 512 directions)
+    const std::vector<glm::vec3> all = makeDirections(512, 2024);
+    for (size_t r : {0u, 1u}) {
+        const std::vector<glm::vec3> dirs = replicate(all, r);
+        for (size_t run : {16u, 32u, 64u, 128u}) {
+            const double iidCosine = std::sqrt(1.0 / 12.0 / double(run));
+            const double iidFolded = std::sqrt(0.75 / double(run));
+            for (size_t begin = 0; begin < dirs.size(); begin += run) {
+                EXPECT_LT(rmsCosineError(dirs, begin, begin + run), 0.65 * iidCosine)
+                    << "run [" << begin << ", " << begin + run << ")";
+                EXPECT_LT(rmsFoldedMeanError(dirs, begin, begin + run), 0.8 * iidFolded)
+                    << "run [" << begin << ", " << begin + run << ")";
+            }
         }
+        // half the set is already nearly as good as the whole
+        EXPECT_LT(rmsCosineError(dirs, 0, 128), 0.2 * std::sqrt(1.0 / 12.0 / 128.0));
+        EXPECT_LT(rmsCosineError(dirs, 0, 256), 0.1 * std::sqrt(1.0 / 12.0 / 256.0));
     }
-    // half the set is already nearly as good as the whole
-    EXPECT_LT(rmsCosineError(dirs, 0, 128), 0.2 * std::sqrt(1.0 / 12.0 / 128.0));
-    EXPECT_LT(rmsCosineError(dirs, 0, 256), 0.1 * std::sqrt(1.0 / 12.0 / 256.0));
 }
 
 TEST(Directions, OrthonormalBasisIsRightHanded) {

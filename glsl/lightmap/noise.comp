@@ -1,0 +1,41 @@
+#version 430
+// The noise estimate (engine/bake/noise.cpp), per sampled texel: the running
+// mean splits into the odd directions' half (halfAccum, kept by the update
+// pass at every halfStride-th texel) and the even directions' (the whole
+// minus the odd: M_e = (M W - M_o W_o) / (W - W_o)). With variances s^2/W_e
+// and s^2/W_o, E[(M_e - M_o)^2] = s^2 (1/W_e + 1/W_o) and the whole's is s^2/W,
+// so (M_e - M_o)^2 W_e W_o / W^2 estimates it (a quarter at equal halves). Writes (sum over RGB of that
+// variance, sum over RGB of L_lm, 1) for texels where both halves hold
+// samples, zeros elsewhere; the CPU sums.
+#include "shared/bundle_layout.h"
+#include "lib/rounding.glsl"
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(binding = BINDING_ACCUM, rg32ui) uniform readonly uimage2DArray accum;
+layout(binding = BINDING_HALF_ACCUM, rg32ui) uniform readonly uimage2DArray halfAccum;
+layout(binding = BINDING_DIRECT, rgba16f) uniform readonly image2DArray directMap;
+layout(binding = BINDING_TARGET, rgba32f) uniform writeonly image2DArray target;
+uniform int halfStride;
+uniform int pageCount;
+uniform ivec2 pageSize;  // of halfAccum
+
+vec4 unpackState(uvec2 p) {
+    return vec4(halfToFloat(p.x), halfToFloat(p.x >> 16u), halfToFloat(p.y), halfToFloat(p.y >> 16u));
+}
+
+void main() {
+    ivec3 h = ivec3(gl_GlobalInvocationID.xy, gl_GlobalInvocationID.z);
+    if (h.x >= pageSize.x || h.y >= pageSize.y || h.z >= pageCount) return;
+    vec4 whole = unpackState(imageLoad(accum, ivec3(h.xy * halfStride, h.z)).rg);
+    vec4 odd = unpackState(imageLoad(halfAccum, h).rg);
+    float evenWeight = whole.a - odd.a;
+    // both halves need weight; the whole's fp16 W rounds, so ask for a margin
+    if (odd.a <= 0.0 || evenWeight <= 0.02 * whole.a) {
+        imageStore(target, h, vec4(0.0));
+        return;
+    }
+    vec3 even = (whole.rgb * whole.a - odd.rgb * odd.a) / evenWeight;
+    vec3 d = even - odd.rgb;
+    vec3 l = whole.rgb + imageLoad(directMap, ivec3(h.xy * halfStride, h.z)).rgb;
+    imageStore(target, h, vec4(dot(d, d) * evenWeight * odd.a / (whole.a * whole.a), l.r + l.g + l.b, 1.0, 0.0));
+}

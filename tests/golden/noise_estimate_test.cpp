@@ -1,0 +1,119 @@
+// The noise estimate (engine/bake/noise.cpp) against the noise it estimates:
+// two bakes that differ only in their seed differ by sqrt(2) x the noise of
+// one, so RMS(A - B) / sqrt(2) / mean is the true relative noise, measured
+// without a reference. Each bake's own estimate (stats.json noise.relative)
+// must lie within a factor 1.5 of it. `--target-noise` stops a bake at the
+// first refresh whose estimate reaches the target.
+//
+// Scenes: the Cornell box with its light carried by the bundles (--direct
+// bundles: all of the light map's noise is the bundles'; explicit emitters'
+// shadow-map noise is outside the estimate) and the open box under a sky;
+// the target on the Cornell box as it bakes by default.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+#include "io/image_io.h"
+#include "support/cli_helper.h"
+#include "support/gl_fixture.h"
+
+namespace bb::test {
+namespace {
+
+struct Bake {
+    io::ImageRgb map;
+    std::vector<bool> covered;
+    nlohmann::json stats;
+};
+
+Bake bake(const TempDir& tmp, const std::string& name, std::vector<std::string> args) {
+    const std::string out = tmp / name;
+    args.insert(args.end(), {"-o", out, "--no-progress"});
+    CliResult r = runCli(args, tmp);
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    Bake b;
+    auto map = io::readImageRgb(out + "/lightmap_0.exr");
+    auto coverage = io::readImageRgb(out + "/coverage_0.png");
+    if (!map || !coverage) return b;
+    b.map = *map;
+    for (const glm::vec3& c : coverage->pixels) b.covered.push_back(c.r > 0.5f);
+    b.stats = nlohmann::json::parse(readFileBytes(out + "/stats.json"), nullptr, false);
+    return b;
+}
+
+// RMS(A - B) / sqrt(2) over the mean of A, on texels covered in both
+double seedNoise(const Bake& a, const Bake& b) {
+    double d2 = 0, sum = 0;
+    size_t n = 0;
+    for (size_t i = 0; i < a.map.pixels.size(); ++i) {
+        if (!a.covered[i] || !b.covered[i]) continue;
+        for (int c = 0; c < 3; ++c) {
+            const double d = a.map.pixels[i][c] - b.map.pixels[i][c];
+            d2 += d * d;
+            sum += a.map.pixels[i][c];
+        }
+        n += 3;
+    }
+    return n == 0 ? -1.0 : std::sqrt(d2 / double(n) / 2.0) / (sum / double(n));
+}
+
+void expectEstimateTracksTheSeedNoise(const std::string& scene, std::vector<std::string> flags, const char* tag) {
+    TempDir tmp(tag);
+    ASSERT_TRUE(tmp.ok());
+    std::vector<std::string> args = {"bake", sourcePath(scene), "--no-preview"};
+    args.insert(args.end(), flags.begin(), flags.end());
+    std::vector<std::string> seed1 = args, seed2 = args;
+    seed1.insert(seed1.end(), {"--seed", "1"});
+    seed2.insert(seed2.end(), {"--seed", "2"});
+    Bake a = bake(tmp, "a", seed1), b = bake(tmp, "b", seed2);
+    ASSERT_FALSE(a.map.pixels.empty());
+    ASSERT_FALSE(b.map.pixels.empty());
+    const double truth = seedNoise(a, b);
+    const double estimateA = a.stats["noise"]["relative"], estimateB = b.stats["noise"]["relative"];
+    std::printf("[noise] %s: seed-to-seed noise %.4f, estimates %.4f (seed 1) %.4f (seed 2), %d texels sampled\n",
+                scene.c_str(), truth, estimateA, estimateB, a.stats["noise"]["sampled_texels"].get<int>());
+    ASSERT_GT(truth, 0.0);
+    for (double e : {estimateA, estimateB}) {
+        EXPECT_GE(e, truth / 1.5) << "the estimate is too low";
+        EXPECT_LE(e, truth * 1.5) << "the estimate is too high";
+    }
+}
+
+TEST(NoiseEstimate, TracksTheSeedToSeedNoiseOnTheCornellBox) {
+    expectEstimateTracksTheSeedNoise("assets/cornell_box/cornell_box.gltf",
+                                     {"--uv-layout", "asset", "--resolution", "64", "--directions", "128", "--direct", "bundles"},
+                                     "noise-cornell");
+}
+
+TEST(NoiseEstimate, TracksTheSeedToSeedNoiseOnTheOpenBoxUnderASky) {
+    expectEstimateTracksTheSeedNoise("assets/open_box/open_box.gltf",
+                                     {"--uv-layout", "asset", "--resolution", "64", "--directions", "64", "--sky", "1,1,1"},
+                                     "noise-open-box");
+}
+
+TEST(NoiseEstimate, TargetNoiseStopsTheBakeWhenReached) {
+    TempDir tmp("noise-target");
+    ASSERT_TRUE(tmp.ok());
+    const std::vector<std::string> args = {"bake", sourcePath("assets/cornell_box/cornell_box.gltf"), "--uv-layout", "asset",
+                                           "--resolution", "64", "--directions", "4096", "--target-noise", "0.04",
+                                           "--no-preview"};
+    Bake a = bake(tmp, "a", args), again = bake(tmp, "again", args);
+    ASSERT_TRUE(a.stats.is_object());
+    const int done = a.stats["directions"]["done"];
+    std::printf("[noise] --target-noise 0.04: stopped after %d directions at %.4f\n", done,
+                a.stats["noise"]["relative"].get<double>());
+    EXPECT_TRUE(a.stats["noise"]["stopped_at_target"].get<bool>());
+    EXPECT_LT(done, 4096);
+    EXPECT_GE(done, 16);
+    EXPECT_LE(a.stats["noise"]["relative"].get<double>(), 0.04);
+    // the estimate before the stop was still above the target
+    const auto& history = a.stats["noise"]["history"];
+    ASSERT_GE(history.size(), 2u);
+    EXPECT_GT(history[history.size() - 2][1].get<double>(), 0.04);
+    EXPECT_EQ(readFileBytes(tmp / "a/lightmap_0.exr"), readFileBytes(tmp / "again/lightmap_0.exr"));
+}
+
+}  // namespace
+}  // namespace bb::test
