@@ -70,6 +70,7 @@ void Baker::Impl::stepTile() {
 }
 
 void Baker::Impl::finishRound(int round) {
+    stats.directionsDone = std::min(options.directions, (round + 1) * shareCount());
     // Refresh the outgoing radiance the next bundles read. After every round
     // while each one adds a bounce the estimate needs; later every j/32 rounds
     // (at most 8): the estimate then moves slowly and the refresh is a pass over every page.
@@ -79,7 +80,6 @@ void Baker::Impl::finishRound(int round) {
         stats.secondsCombine += secondsSince(tr);
         tr = Clock::now();
         refreshRadiance(uint32_t(round));
-        stats.directionsDone = std::min(options.directions, (round + 1) * shareCount());
         estimateNoise();  // on the combined sums: every baker stops at the same round
         if (shareIndex() > 0) {  // what this baker adds from now on, alone: baker 0 holds the sums
             const GLuint zero[4] = {0, 0, 0, 0};
@@ -90,7 +90,6 @@ void Baker::Impl::finishRound(int round) {
         stats.secondsResolve += secondsSince(tr);
         combined = true;
     }
-    stats.directionsDone = std::min(options.directions, (round + 1) * shareCount());
 }
 
 void Baker::Impl::combineShares(int round) {
