@@ -14,6 +14,7 @@
 #include "core/log.h"
 #include "headless/cli/options.h"
 #include "bake/bake_output.h"
+#include "bake/seam_stitch.h"
 #include "headless/cli/progress.h"
 #include "headless/mpi/mpi_share.h"
 #include "headless/platform.h"
@@ -72,6 +73,10 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
                    "Stop once the estimated relative noise of the light maps is at most this (e.g. 0.01; checked at "
                    "radiance refreshes from 16 directions on; --directions is then the most); 0 = off")
         ->check(CLI::Range(0.0, 1.0))
+        ->capture_default_str();
+    cmd.add_option("--seams", a.seams,
+                   "UV seams: stitch (least squares over the texels along them, so both sides agree) or off")
+        ->check(CLI::IsMember({"stitch", "off"}))
         ->capture_default_str();
     cmd.add_option("--checkpoint-every", a.checkpointEvery,
                    "Write OUTDIR/checkpoint.bin every N directions (0 = never)")
@@ -216,12 +221,14 @@ int runBake(const BakeArgs& args) {
                      {"uv_layout", args.scene.uvLayout}, {"resolution", args.scene.resolution},
                      {"texel_density", args.scene.texelDensity}, {"history_power", (*baker)->stats().historyPower},
                      {"direct", args.direct}, {"emitter_samples", args.emitterSamples},
-                     {"mpi_ranks", mpi ? mpi->count() : 1}, {"target_noise", args.targetNoise}};
+                     {"seams", args.seams}, {"mpi_ranks", mpi ? mpi->count() : 1}, {"target_noise", args.targetNoise}};
     info.wallSeconds = seconds;
     info.writePreviews = args.preview;
     LightmapPages maps = (*baker)->readLightmaps();  // before the stats: its read-back memory counts
     nlohmann::json stats = (*baker)->stats().toJson();
     if (mpi) stats["mpi"] = mpiFigures;
+    if (args.seams == "stitch")
+        stats["seams"] = stitchSeams(maps, findSeams((*baker)->mesh(), maps.resolution)).toJson();
     if (Status s = writeBakeOutputs(args.outDir, loaded->scene, loaded->layout, maps, stats, info); !s)
         return fail(s.message());
     if (args.checkpointEvery > 0 || args.resume) std::filesystem::remove(checkpoint);  // the outputs supersede it

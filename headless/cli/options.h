@@ -49,6 +49,7 @@ struct BakeArgs {
     float historyPower = -1.0f;
     std::string direct = "auto";
     int emitterSamples = 128;
+    std::string seams = "stitch";     // stitch | off (bake/seam_stitch.h)
     bool preview = true;
     bool progress = true;
 };

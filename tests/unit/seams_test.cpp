@@ -1,0 +1,105 @@
+// Seam finding (layout/seams.h) on hand-made bake meshes, and seam stitching
+// (bake/seam_stitch.h) on a synthetic page with a step across a seam.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "bake/seam_stitch.h"
+#include "layout/seams.h"
+
+namespace bb {
+namespace {
+
+// A unit quad in z = 0 as two triangles sharing the diagonal (0,0)-(1,1), on
+// page 0; light map uv = position / 4 (+ offsetB on the second triangle).
+BakeMesh quadMesh(glm::vec2 offsetB, glm::vec3 normalB = {0, 0, 1}, uint32_t instanceB = 0) {
+    BakeMesh m;
+    const glm::vec2 corners[2][3] = {{{0, 0}, {1, 0}, {1, 1}}, {{0, 0}, {1, 1}, {0, 1}}};
+    for (int t = 0; t < 2; ++t) {
+        for (int k = 0; k < 3; ++k) {
+            BakeVertex v;
+            v.position = glm::vec4(corners[t][k], 0, 1);
+            v.normal = glm::vec4(t == 0 ? glm::vec3(0, 0, 1) : normalB, 0);
+            v.lightmapUv = corners[t][k] * 0.25f + (t == 1 ? offsetB : glm::vec2(0));
+            m.vertices.push_back(v);
+        }
+        m.triangles.push_back({0, 0, t == 1 ? instanceB : 0u, 0});
+    }
+    m.pageFirstTriangle = {0, 2};
+    return m;
+}
+
+TEST(Seams, OneChartHasNoSeam) {
+    const Seams s = findSeams(quadMesh({0, 0}), 16);
+    EXPECT_EQ(s.seamEdges, 0u);
+    EXPECT_EQ(s.hardEdges, 0u);
+    EXPECT_TRUE(s.samples.empty());
+}
+
+TEST(Seams, SplitDiagonalIsOneSeamSampledAlongBothSides) {
+    const Seams s = findSeams(quadMesh({0.5f, 0}), 16);
+    ASSERT_EQ(s.seamEdges, 1u);
+    EXPECT_EQ(s.hardEdges, 0u);
+    // the diagonal is 16 x 0.25 x sqrt 2 = 5.66 texels: ceil(3 x 5.66) = 17 pairs
+    ASSERT_EQ(s.samples.size(), 17u);
+    for (const SeamSamplePair& p : s.samples) {
+        // the same point of the edge on both sides: B is A moved by the offset (8 texels)
+        EXPECT_NEAR(p.texelB.x - p.texelA.x, 8.0f, 1e-4f);
+        EXPECT_NEAR(p.texelB.y - p.texelA.y, 0.0f, 1e-4f);
+        EXPECT_NEAR(p.texelA.x, p.texelA.y, 1e-4f);  // on the diagonal
+        EXPECT_GT(p.texelA.x, 0.0f);
+        EXPECT_LT(p.texelA.x, 4.0f);
+    }
+}
+
+TEST(Seams, HardEdgeAndOtherInstanceAreNotSeams) {
+    const Seams hard = findSeams(quadMesh({0.5f, 0}, glm::normalize(glm::vec3(0, 1, 1))), 16);
+    EXPECT_EQ(hard.seamEdges, 0u);
+    EXPECT_EQ(hard.hardEdges, 1u);
+    const Seams apart = findSeams(quadMesh({0.5f, 0}, {0, 0, 1}, 1), 16);
+    EXPECT_EQ(apart.seamEdges, 0u);
+    EXPECT_EQ(apart.hardEdges, 0u);
+}
+
+// A 16 x 16 page, 1 left of x = 8 and 2 from it; a seam from (4, 2) to (4, 10)
+// on side A and (12, 2) to (12, 10) on side B: a step of 1 across it.
+TEST(SeamStitch, StepAcrossSeamIsStitchedAndTheRestKept) {
+    LightmapPages maps;
+    maps.resolution = 16;
+    maps.pages.resize(1);
+    maps.pages[0].width = maps.pages[0].height = 16;
+    for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 16; ++x) maps.pages[0].pixels.push_back(glm::vec3(x < 8 ? 1.0f : 2.0f));
+    maps.covered.assign(1, std::vector<uint8_t>(256, 1));
+    Seams seams;
+    seams.seamEdges = 1;
+    for (int s = 0; s < 24; ++s) {
+        const float y = 2.0f + 8.0f * (float(s) + 0.5f) / 24.0f;
+        seams.samples.push_back({0, 0, 0, {4.0f, y}, {12.0f, y}});
+    }
+    const LightmapPages baked = maps;
+    const SeamStitchStats st = stitchSeams(maps, seams);
+    ASSERT_TRUE(st.solved);
+    EXPECT_NEAR(st.rmsBefore, 1.0, 1e-9);
+    EXPECT_NEAR(st.meanValue, 1.5, 1e-9);
+    // keepWeight 0.1: the step shrinks by about 19x (measured 0.0531)
+    EXPECT_LT(st.rmsAfter, 0.06 * st.rmsBefore) << st.toJson().dump();
+    EXPECT_EQ(st.samplePairs, 24u);
+    // columns 3, 4 and 11, 12 of rows 1..10 (the lookups' taps)
+    EXPECT_EQ(st.texelsAdjusted, 2u * 2u * 10u);
+    // symmetric: both sides meet half way
+    EXPECT_NEAR(seamDifference(maps, seams).mean, 1.5, 0.01);
+    size_t changed = 0;
+    for (size_t i = 0; i < 256; ++i) changed += maps.pages[0].pixels[i] != baked.pages[0].pixels[i];
+    EXPECT_LE(changed, st.texelsAdjusted);
+    EXPECT_EQ(maps.pages[0].at(0, 0), baked.pages[0].at(0, 0));
+    EXPECT_EQ(maps.pages[0].at(8, 5), baked.pages[0].at(8, 5));
+    EXPECT_EQ(maps.pages[0].at(4, 12), baked.pages[0].at(4, 12));
+    // same input, same bytes
+    LightmapPages again = baked;
+    stitchSeams(again, seams);
+    EXPECT_EQ(again.pages[0].pixels, maps.pages[0].pixels);
+}
+
+}  // namespace
+}  // namespace bb
