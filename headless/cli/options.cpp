@@ -105,12 +105,16 @@ const char* uvLayoutName(UvLayout mode) {
     return mode == UvLayout::Asset ? "asset" : mode == UvLayout::Generate ? "generate" : "pack";
 }
 
-Expected<LoadedScene> loadSceneAndLayout(const SceneArgs& a) {
+Expected<Scene> loadSceneFromArgs(const SceneArgs& a) {
     auto albedo = parseColor(a.defaultAlbedo, "--default-albedo");
     if (!albedo) return albedo.status();
     LoadOptions lo;
     lo.defaultAlbedo = *albedo;
-    auto scene = loadScene(a.scene, lo);
+    return loadScene(a.scene, lo);
+}
+
+Expected<LoadedScene> loadSceneAndLayout(const SceneArgs& a) {
+    auto scene = loadSceneFromArgs(a);
     if (!scene) return scene.status();
     LayoutOptions opts;
     opts.mode = parseUvLayout(a.uvLayout);
@@ -159,11 +163,7 @@ Expected<LoadedScene> loadSceneWithBakeLayout(const SceneArgs& a, const LayoutFl
     }
     opts.failOnOverlap = false;  // the bake accepted its layout
 
-    auto albedo = parseColor(a.defaultAlbedo, "--default-albedo");
-    if (!albedo) return albedo.status();
-    LoadOptions lo;
-    lo.defaultAlbedo = *albedo;
-    auto scene = loadScene(a.scene, lo);
+    auto scene = loadSceneFromArgs(a);
     if (!scene) return scene.status();
     if (scene->instances.size() != manifest->instanceCount)
         return Expected<LoadedScene>::failure(a.scene + " has " + std::to_string(scene->instances.size()) +
@@ -178,11 +178,7 @@ Expected<LoadedScene> loadSceneWithBakeLayout(const SceneArgs& a, const LayoutFl
 int runInfo(const InfoArgs& args) {
     // the scene is described even when no layout can be made for it (no
     // TEXCOORD_1): the layout lines then say why
-    auto albedo = parseColor(args.scene.defaultAlbedo, "--default-albedo");
-    if (!albedo) return fail(albedo.error());
-    LoadOptions lo;
-    lo.defaultAlbedo = *albedo;
-    auto scene = loadScene(args.scene.scene, lo);
+    auto scene = loadSceneFromArgs(args.scene);
     if (!scene) return fail(scene.error());
     LayoutOptions opts;
     opts.mode = parseUvLayout(args.scene.uvLayout);

@@ -71,6 +71,8 @@ struct LoadedScene {
 };
 // Generates TEXCOORD_1 where the layout needs it (see computeLayout(Scene&)).
 Expected<LoadedScene> loadSceneAndLayout(const SceneArgs& args);
+// The scene of `args` loaded with its --default-albedo (no layout).
+Expected<Scene> loadSceneFromArgs(const SceneArgs& args);
 
 // The layout flags the command line gave (not their defaults): commands that
 // read a bake's manifest.json take its layout and refuse a flag that differs.

@@ -93,11 +93,7 @@ int runRender(const RenderArgs& args) {
     } else {
         if (args.given.uvLayout || args.given.resolution || args.given.texelDensity)
             return fail("the layout flags apply to a bake directory; an exported file's TEXCOORD_1 is its layout");
-        auto albedo = parseColor(args.scene.defaultAlbedo, "--default-albedo");
-        if (!albedo) return fail(albedo.error());
-        LoadOptions lo;
-        lo.defaultAlbedo = *albedo;
-        auto scene = loadScene(args.scene.scene, lo);
+        auto scene = loadSceneFromArgs(args.scene);
         if (!scene) return fail(scene.error());
         auto exported = readExportedLightmaps(args.scene.scene, *scene);
         if (!exported) return fail(exported.error());
