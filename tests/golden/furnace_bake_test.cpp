@@ -38,6 +38,8 @@ struct FurnaceCase {
     int directions;
     double texelTolerance;  // relative, every covered texel and channel
     BakeOptions::Tiling tiling = BakeOptions::Tiling::Adaptive;
+    double meanTolerance = 0.01;  // relative
+    float albedo = -1.0f;         // >= 0: every material's albedo replaced (rho 0.99 from the rho 0.9 file)
 };
 
 void runFurnace(const FurnaceCase& fc) {
@@ -47,7 +49,11 @@ void runFurnace(const FurnaceCase& fc) {
     options.directions = fc.directions;
     options.seed = 1;
     options.tiling = fc.tiling;
-    SceneBake bake = makeBake(fc.file, assetLayout(64), options);
+    SceneBake bake = fc.albedo >= 0.0f ? makeBake(fc.file, assetLayout(64), options,
+                                                  [&](Scene& scene) {
+                                                      for (Material& m : scene.materials) m.albedo = glm::vec3(fc.albedo);
+                                                  })
+                                       : makeBake(fc.file, assetLayout(64), options);
     ASSERT_TRUE(bake) << bake.error;
     const double seconds = bakeToEnd(*bake.baker);
     LightmapPages maps = bake.baker->readLightmaps();
@@ -59,8 +65,9 @@ void runFurnace(const FurnaceCase& fc) {
                 fc.directions, seconds, describe(s, 64).c_str(), answer, expectation);
 
     ASSERT_GT(s.count, 3u * 2000u) << "the furnace covers 58% of the 64 x 64 atlas: 2478 texels";
-    EXPECT_NEAR(s.mean, answer, 0.01 * answer)
-        << "furnace mean over covered texels is not within 1% of Le / (1 - rho) = " << answer << " after "
+    EXPECT_NEAR(s.mean, answer, fc.meanTolerance * answer)
+        << "furnace mean over covered texels is not within " << fc.meanTolerance * 100
+        << "% of Le / (1 - rho) = " << answer << " after "
         << fc.directions << " directions; " << describe(s, 64);
     EXPECT_GE(s.min, answer * (1.0 - fc.texelTolerance))
         << "a furnace texel is more than " << fc.texelTolerance * 100 << "% below " << answer << ": "
@@ -73,7 +80,17 @@ void runFurnace(const FurnaceCase& fc) {
 
 TEST(FurnaceBake, Rho05Gives2Everywhere) { runFurnace({"assets/furnace/furnace.gltf", 0.5, 256, 0.04}); }
 
-TEST(FurnaceBake, Rho09Gives10Everywhere) { runFurnace({"assets/furnace/furnace_rho09.gltf", 0.9, 1024, 0.04}); }
+// rho 0.9 at 1024 directions: mean within 0.3 % (issue 11; seed 1 reads 9.981, -0.19 %)
+TEST(FurnaceBake, Rho09Gives10Everywhere) {
+    runFurnace({"assets/furnace/furnace_rho09.gltf", 0.9, 1024, 0.04, BakeOptions::Tiling::Adaptive, 0.003});
+}
+
+// rho 0.99 (answer 100) needs ~700 bounces: the refresh follows every
+// direction until rho^b < 1e-3 (baker.cpp). 4096 directions: mean 98.3
+// (-1.7 %; 71.3 with the schedule before); texels within 4 %. Issue 11: within 2 %.
+TEST(FurnaceBake, Rho099Gives100Everywhere) {
+    runFurnace({"assets/furnace/furnace_rho09.gltf", 0.99, 4096, 0.04, BakeOptions::Tiling::Adaptive, 0.02, 0.99f});
+}
 
 // The Hermes et al. baseline (--tiling uniform) gives the same answers.
 TEST(FurnaceBake, UniformTilingRho05Gives2Everywhere) {

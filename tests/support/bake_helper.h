@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <cstdlib>
 #include <filesystem>
 #include <cstdio>
@@ -38,8 +39,9 @@ struct SceneBake {
     explicit operator bool() const { return baker != nullptr; }
 };
 
+// `edit`, if given, changes the loaded scene before it is laid out (materials, lights).
 inline SceneBake makeBake(const std::string& assetRelative, const LayoutOptions& layoutOptions,
-                          const BakeOptions& bakeOptions) {
+                          const BakeOptions& bakeOptions, const std::function<void(Scene&)>& edit = {}) {
     SceneBake out;
     auto scene = loadScene(sourcePath(assetRelative));
     if (!scene) {
@@ -47,6 +49,7 @@ inline SceneBake makeBake(const std::string& assetRelative, const LayoutOptions&
         return out;
     }
     out.scene = std::move(scene.value());
+    if (edit) edit(out.scene);
     auto layout = computeLayout(out.scene, layoutOptions);
     if (!layout) {
         out.error = "computeLayout: " + layout.error();
@@ -176,13 +179,16 @@ inline std::string describe(const Summary& s, int resolution) {
     return buf;
 }
 
-// The baker's radiance-map refresh schedule (engine/bake/baker.cpp,
-// bakeDirection): after direction k (0-based) the outgoing radiance the next
-// bundles read is re-resolved when (k + 1) % clamp(k / 32, 1, 8) == 0 or k is
-// the last direction. Mirrored here for furnaceExpectation(); if the engine's
-// schedule changes, update this (it moves the rho 0.9 expectations by ~0.1%).
-inline bool radianceRefreshedAfter(int k, int directions) {
-    const int interval = std::clamp(k / 32, 1, 8);
+// The baker's radiance-map refresh schedule (Baker::Impl::refreshInterval,
+// refreshEveryRound): after direction k (0-based) the outgoing radiance the
+// next bundles read is refreshed after every direction until the bounces the
+// largest albedo rho needs (ln 1000 / (1 - rho), at least 64), then when
+// (k + 1) % clamp((k - shift) / 32, 1, 8) == 0, and after the last direction.
+// Mirrored here for furnaceExpectation(); if the engine's schedule changes,
+// update this (it moves the rho 0.9 expectations by ~0.1%).
+inline bool radianceRefreshedAfter(int k, int directions, double rho) {
+    const int everyDirection = std::max(64, int(std::ceil(std::log(1000.0) / (1.0 - std::min(rho, 0.99)))));
+    const int interval = std::clamp((k - std::max(0, everyDirection - 64)) / 32, 1, 8);
     return (k + 1) % interval == 0 || k + 1 == directions;
 }
 
@@ -198,11 +204,12 @@ inline double furnaceExpectation(double le, double rho, int directions, double h
     const double rampEnd = std::max(1, directions / 2);
     double sum = 0, weights = 0, m = 0, r = 0;
     for (int k = 0; k < directions; ++k) {
-        const double w = std::pow(std::min(double(k + 1), rampEnd), historyPower);
+        // relative to the ramp's last weight: powers up to 256 stay in range
+        const double w = std::exp(historyPower * (std::log(std::min(double(k + 1), rampEnd)) - std::log(rampEnd)));
         sum += w * (le + rho * r);
         weights += w;
-        m = sum / weights;
-        if (radianceRefreshedAfter(k, directions)) r = m;
+        m = weights > 0 ? sum / weights : le + rho * r;  // early weights can underflow to 0
+        if (radianceRefreshedAfter(k, directions, rho)) r = m;
     }
     return m;
 }
@@ -210,7 +217,7 @@ inline double furnaceExpectation(double le, double rho, int directions, double h
 // The baker's default history power for a largest albedo rho (BakeOptions::historyPower < 0).
 inline double defaultHistoryPower(double rho) {
     rho = std::min(rho, 0.99);
-    return std::clamp(std::round(2.0 * rho / (1.0 - rho)), 1.0, 32.0);
+    return std::clamp(std::round(2.0 * rho / (1.0 - rho)), 1.0, 256.0);
 }
 
 // --- texels to triangles (CPU) ----------------------------------------------
