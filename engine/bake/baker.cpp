@@ -169,6 +169,12 @@ void Baker::Impl::rescaleAccumulators(float factor, uint32_t seed) {
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
 }
 
+void Baker::Impl::clearAccumulators() {
+    const GLuint zero[4] = {0, 0, 0, 0};
+    glClearTexImage(accum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, zero);
+    glClearTexImage(halfAccum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, zero);
+}
+
 void Baker::Impl::uploadMaterials(const Scene& scene) {
     // material textures (linear RGBA, mipmapped)
     for (size_t i = 0; i < scene.textures.size(); ++i) {
@@ -429,12 +435,12 @@ Status Baker::Impl::init(const Scene& scene) {
         halfWidth = (res + stats.noiseStride - 1) / stats.noiseStride;
         halfAccum = gl::Texture::create2DArray("noise estimate: odd directions' accumulators", GL_RG32UI, halfWidth,
                                                halfWidth, pages);
+        noiseTerms = gl::Texture::create2DArray("noise estimate terms", GL_RGBA32F, halfWidth, halfWidth, pages);
     }
     glTextureParameteri(radiance.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     glTextureParameteri(radiance.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     const uint32_t zero[4] = {0, 0, 0, 0};
-    glClearTexImage(accum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, zero);
-    glClearTexImage(halfAccum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, zero);
+    clearAccumulators();
     glClearTexImage(radianceBits.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, zero);
     glClearTexImage(direct.id(), 0, GL_RGBA, GL_FLOAT, zero);
     pageFbo = gl::Framebuffer::create("light map page framebuffer (no attachments)");

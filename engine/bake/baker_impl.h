@@ -64,6 +64,7 @@ struct Baker::Impl {
     // the noise estimate (noise.cpp): the odd directions' accumulators at every
     // noiseStride-th texel (8 bytes / stride^2 a page texel; its own memory category)
     gl::Texture halfAccum;
+    gl::Texture noiseTerms;  // noise.comp's per-texel terms (RGBA32F, halfAccum's size)
     int halfWidth = 1;     // halfAccum's side: ceil(resolution / stride)
     gl::Texture envTexture;
     gl::Framebuffer pageFbo;
@@ -140,6 +141,7 @@ struct Baker::Impl {
     void dispatchPages(GLuint program);
     // The accumulators' weights times `factor` (both the whole's and the noise half's).
     void rescaleAccumulators(float factor, uint32_t seed);
+    void clearAccumulators();  // both to zero: no sample (a share's bakers other than 0 after a combine)
     // noise.cpp: the relative noise now (stats.noiseRelative), kept in the
     // history; stops the bake (directionsGoal) when --target-noise is reached
     void estimateNoise();

@@ -238,11 +238,7 @@ Status Baker::loadCheckpoint(const std::string& path) {
     m.stats = restored;
     m.stats.directionsDone = h.directionsDone;
     m.accumLogScale = h.accumLogScale;
-    if (m.shareIndex() > 0) {  // the sums are baker 0's to hold
-        const GLuint zero[4] = {0, 0, 0, 0};
-        glClearTexImage(m.accum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, zero);
-        glClearTexImage(m.halfAccum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, zero);
-    }
+    if (m.shareIndex() > 0) m.clearAccumulators();  // the sums are baker 0's to hold
     m.combined = true;
     return Status::ok();
 }

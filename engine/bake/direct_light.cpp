@@ -110,6 +110,47 @@ bool Baker::Impl::useExplicitEmitters() const {
     return emitters > 0 && emitters <= 1024 && emitterArea <= 0.25 * area;
 }
 
+// auto: 4 cube texels per bundle pixel across (gridSize pixels span the
+// scene's diameter). Measured on the Cornell box at 64^2 texels: 64^2 faces
+// raise the error from 4.3 % to 5.0 %, 256^2 and 512^2 give 4.3 % and 256^2
+// costs 0.3 s instead of 0.5 s.
+namespace {
+int shadowCubeSize(const Baker::Impl& m) {
+    int size = m.options.emitterShadowSize;
+    if (size <= 0) {
+        size = 64;
+        while (size < 4 * m.gridSize && size < 512) size *= 2;
+    }
+    return size;
+}
+
+// One light's (an emitter sample's, a point or spot light's) irradiance times
+// the visibility `cube` holds, into the direct light's float sums: `program`
+// (its light uniforms set) over every page.
+void addVisibleLight(Baker::Impl& m, const gl::Program& program, const DistanceCube& cube) {
+    const float pixelSize = m.pixelSize;
+    // the visibility test starts half a bundle pixel off the receiver. Bias: a
+    // quarter bundle pixel, plus (in the shader) half a cube texel's footprint
+    // at the receiver's distance, the error of a nearest lookup. Kept well
+    // under a texel so walls one texel thick still cast shadows.
+    glUniform1f(program.uniform("normalOffset"), 0.5f * pixelSize);
+    glUniform1f(program.uniform("distanceBias"), 0.25f * pixelSize);
+    glUniform1f(program.uniform("footprintPerDistance"), 1.0f / float(cube.size));
+    glBindTextureUnit(0, cube.cube.id());
+    glBindImageTexture(BINDING_SCRATCH_RG, m.accumAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32F);
+    glBindImageTexture(BINDING_SCRATCH_B, m.radianceAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
+    glBindFramebuffer(GL_FRAMEBUFFER, m.pageFbo.id());
+    glViewport(0, 0, m.layout.resolution, m.layout.resolution);
+    const std::vector<uint32_t>& first = m.mesh.pageFirstTriangle;
+    for (int page = 0; page < m.layout.pageCount; ++page) {
+        glUniform1i(program.uniform("page"), page);
+        const int64_t count = int64_t(first[page + 1]) - first[page];
+        if (count) glDrawArrays(GL_TRIANGLES, drawFirstVertex(first[page]), GLsizei(count * 3));
+    }
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+}
+}  // namespace
+
 void Baker::Impl::bakeEmitters() {
     gl::DebugGroup group("explicit emitters");
     MemoryCategory category("direct light");
@@ -135,22 +176,8 @@ void Baker::Impl::bakeEmitters() {
     for (auto& e : emitters)
         e.samples = std::max(1, int(std::lround(options.emitterSamples * (totalPower > 0 ? e.power / totalPower : 0.0))));
 
-    // auto: 4 cube texels per bundle pixel across (gridSize pixels span the
-    // scene's diameter). Measured on the Cornell box at 64^2 texels: 64^2
-    // faces raise the error from 4.3 % to 5.0 %, 256^2 and 512^2 give 4.3 %
-    // and 256^2 costs 0.3 s instead of 0.5 s.
-    int size = options.emitterShadowSize;
-    if (size <= 0) {
-        size = 64;
-        while (size < 4 * gridSize && size < 512) size *= 2;
-    }
-    DistanceCube cube(size, triangleBuffer.id(), int64_t(mesh.triangles.size()));
+    DistanceCube cube(shadowCubeSize(*this), triangleBuffer.id(), int64_t(mesh.triangles.size()));
     const float nearPlane = 1e-4f * sphereRadius, farPlane = 4.0f * sphereRadius;
-    const float normalOffset = 0.5f * pixelSize;
-    // Bias: a quarter bundle pixel, plus (in the shader) half a cube texel's
-    // footprint at the receiver's distance, the error of a nearest lookup.
-    // Kept well under a texel so walls one texel thick still cast shadows.
-    const float distanceBias = 0.25f * pixelSize;
 
     for (const Emitter& e : emitters) {
         const BakeVertex* v = &mesh.vertices[e.triangle * 3];
@@ -178,20 +205,7 @@ void Baker::Impl::bakeEmitters() {
             glUniform1i(emitterProgram.uniform("emitterDoubleSided"), doubleSided);
             glUniform3fv(emitterProgram.uniform("radianceOverSamples"), 1, &perSample.x);
             glUniform3fv(emitterProgram.uniform("samplePoint"), 1, &point.x);
-            glUniform1f(emitterProgram.uniform("normalOffset"), normalOffset);
-            glUniform1f(emitterProgram.uniform("distanceBias"), distanceBias);
-            glUniform1f(emitterProgram.uniform("footprintPerDistance"), 1.0f / float(size));
-            glBindTextureUnit(0, cube.cube.id());
-            glBindImageTexture(BINDING_SCRATCH_RG, accumAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32F);
-            glBindImageTexture(BINDING_SCRATCH_B, radianceAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
-            glBindFramebuffer(GL_FRAMEBUFFER, pageFbo.id());
-            glViewport(0, 0, layout.resolution, layout.resolution);
-            for (int page = 0; page < layout.pageCount; ++page) {
-                glUniform1i(emitterProgram.uniform("page"), page);
-                const int64_t count = int64_t(mesh.pageFirstTriangle[page + 1]) - mesh.pageFirstTriangle[page];
-                if (count) glDrawArrays(GL_TRIANGLES, drawFirstVertex(mesh.pageFirstTriangle[page]), GLsizei(count * 3));
-            }
-            glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+            addVisibleLight(*this, emitterProgram, cube);
             ++stats.emitterSampleCount;
         }
     }
@@ -205,17 +219,8 @@ void Baker::Impl::bakeEmitters() {
 void Baker::Impl::bakePunctualLights() {
     gl::DebugGroup group("point and spot lights");
     MemoryCategory category("direct light");
-    // the cube face as the emitters' (4 cube texels per bundle pixel across)
-    int size = options.emitterShadowSize;
-    if (size <= 0) {
-        size = 64;
-        while (size < 4 * gridSize && size < 512) size *= 2;
-    }
-    DistanceCube cube(size, triangleBuffer.id(), int64_t(mesh.triangles.size()));
+    DistanceCube cube(shadowCubeSize(*this), triangleBuffer.id(), int64_t(mesh.triangles.size()));
     bindAlphaMasks();
-    // biases as the emitters' (bakeEmitters says why)
-    const float normalOffset = 0.5f * pixelSize;
-    const float distanceBias = 0.25f * pixelSize;
     for (const PunctualLight& light : punctualLights) {
         const glm::vec3 position(light.position - mesh.origin);  // local space, as the mesh
         // every surface lies within |position - centre| + radius of the light
@@ -225,8 +230,7 @@ void Baker::Impl::bakePunctualLights() {
 
         const glm::vec3 intensity = light.intensity / radianceUnit;
         const float cosOuter = std::cos(light.outerConeAngle), cosInner = std::cos(light.innerConeAngle);
-        const GLuint p = punctualProgram.id();
-        glUseProgram(p);
+        glUseProgram(punctualProgram.id());
         glUniform3fv(punctualProgram.uniform("lightPosition"), 1, &position.x);
         glUniform3fv(punctualProgram.uniform("lightIntensity"), 1, &intensity.x);
         glUniform1f(punctualProgram.uniform("lightRange"), light.range);
@@ -234,20 +238,7 @@ void Baker::Impl::bakePunctualLights() {
         glUniform3fv(punctualProgram.uniform("spotDirection"), 1, &light.direction.x);
         glUniform1f(punctualProgram.uniform("spotCosOuter"), cosOuter);
         glUniform1f(punctualProgram.uniform("spotScale"), 1.0f / std::max(0.001f, cosInner - cosOuter));
-        glUniform1f(punctualProgram.uniform("normalOffset"), normalOffset);
-        glUniform1f(punctualProgram.uniform("distanceBias"), distanceBias);
-        glUniform1f(punctualProgram.uniform("footprintPerDistance"), 1.0f / float(size));
-        glBindTextureUnit(0, cube.cube.id());
-        glBindImageTexture(BINDING_SCRATCH_RG, accumAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32F);
-        glBindImageTexture(BINDING_SCRATCH_B, radianceAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
-        glBindFramebuffer(GL_FRAMEBUFFER, pageFbo.id());
-        glViewport(0, 0, layout.resolution, layout.resolution);
-        for (int page = 0; page < layout.pageCount; ++page) {
-            glUniform1i(glGetUniformLocation(p, "page"), page);
-            const int64_t count = int64_t(mesh.pageFirstTriangle[page + 1]) - mesh.pageFirstTriangle[page];
-            if (count) glDrawArrays(GL_TRIANGLES, drawFirstVertex(mesh.pageFirstTriangle[page]), GLsizei(count * 3));
-        }
-        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+        addVisibleLight(*this, punctualProgram, cube);
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }

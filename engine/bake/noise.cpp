@@ -14,7 +14,6 @@
 
 #include "bake/baker_impl.h"
 #include "core/log.h"
-#include "core/memory.h"
 #include "gl/gl.h"
 #include "glsl/shared/bundle_layout.h"
 
@@ -22,11 +21,6 @@ namespace bb {
 
 void Baker::Impl::estimateNoise() {
     gl::DebugGroup group("noise estimate");
-    gl::Texture terms;
-    {
-        MemoryCategory category("noise estimate");
-        terms = gl::Texture::create2DArray("noise estimate terms", GL_RGBA32F, halfWidth, halfWidth, layout.pageCount);
-    }
     glUseProgram(noiseProgram.id());
     glUniform1i(noiseProgram.uniform("halfStride"), stats.noiseStride);
     glUniform1i(noiseProgram.uniform("pageCount"), layout.pageCount);
@@ -34,11 +28,11 @@ void Baker::Impl::estimateNoise() {
     glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RG32UI);
     glBindImageTexture(BINDING_HALF_ACCUM, halfAccum.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RG32UI);
     glBindImageTexture(BINDING_DIRECT, direct.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
-    glBindImageTexture(BINDING_TARGET, terms.id(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(BINDING_TARGET, noiseTerms.id(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glDispatchCompute(GLuint(halfWidth + 7) / 8, GLuint(halfWidth + 7) / 8, GLuint(layout.pageCount));
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
     std::vector<glm::vec4> values(size_t(halfWidth) * halfWidth * size_t(layout.pageCount));
-    gl::readTexture(terms.id(), 0, 0, 0, halfWidth, halfWidth, layout.pageCount, GL_RGBA, GL_FLOAT, 16, values.data());
+    gl::readTexture(noiseTerms.id(), 0, 0, 0, halfWidth, halfWidth, layout.pageCount, GL_RGBA, GL_FLOAT, 16, values.data());
     double variance = 0, sum = 0;
     int64_t texels = 0;
     for (const glm::vec4& v : values) {

@@ -81,11 +81,7 @@ void Baker::Impl::finishRound(int round) {
         tr = Clock::now();
         refreshRadiance(uint32_t(round));
         estimateNoise();  // on the combined sums: every baker stops at the same round
-        if (shareIndex() > 0) {  // what this baker adds from now on, alone: baker 0 holds the sums
-            const GLuint zero[4] = {0, 0, 0, 0};
-            glClearTexImage(accum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, zero);
-            glClearTexImage(halfAccum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, zero);
-        }
+        if (shareIndex() > 0) clearAccumulators();  // what this baker adds from now on, alone: baker 0 holds the sums
         glFinish();
         stats.secondsResolve += secondsSince(tr);
         combined = true;
