@@ -130,6 +130,7 @@ Status Baker::Impl::buildPrograms() {
         {&directFoldProgram, {"lightmap/direct_fold.comp"}, rounding},
         {&distanceProgram, {"direct/distance.vert", "direct/distance.frag"}, ""},
         {&emitterProgram, {"direct/emitter.vert", "direct/emitter.frag"}, ""},
+        {&emitterFoldProgram, {"direct/emitter_fold.comp"}, ""},
         {&punctualProgram, {"direct/emitter.vert", "direct/punctual.frag"}, ""},
     };
     for (auto& s : specs) {

@@ -69,7 +69,8 @@ struct Baker::Impl {
     gl::Texture envTexture;
     gl::Framebuffer pageFbo;
     gl::Program updateProgram, sunProgram, resolveProgram, rescaleProgram, metaProgram, coverageProgram,
-        dilateProgram, directFoldProgram, distanceProgram, emitterProgram, punctualProgram, noiseProgram;
+        dilateProgram, directFoldProgram, distanceProgram, emitterProgram, emitterFoldProgram, punctualProgram,
+        noiseProgram;
     gl::Buffer materialAlphaBuffer, alphaTexelBuffer;  // cut-outs (glsl/shared/material_layout.h; cutouts.cpp)
     std::vector<glm::vec3> textureMeans;  // mean linear RGB of each scene texture (explicit emitters)
     std::vector<gl::Texture> materialTextures;

@@ -76,10 +76,12 @@ void Baker::Impl::bakeSun() {
     const double jitterUnit = sunPixelSize > 0 ? sunPixelSize : pixelSize;
     for (size_t li = 0; li < lights.size(); ++li) {
         const glm::vec3 irradiance = lights[li].irradiance / radianceUnit;
+        uint32_t footprintSample = 0;  // the jitter's index: each one samples another point of every texel's footprint
         const BundleTracer::UpdateFn update = [&](const TileFrame&, uint32_t) -> GLuint {
             glUseProgram(sunProgram.id());
             glUniform3fv(sunProgram.uniform("sunIrradiance"), 1, &irradiance.x);
             glUniform1f(sunProgram.uniform("depthBias"), depthBias);
+            glUniform1ui(sunProgram.uniform("footprintSample"), footprintSample);
             glBindImageTexture(BINDING_SCRATCH_RG, accumAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32F);
             glBindImageTexture(BINDING_SCRATCH_B, radianceAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
             glBindImageTexture(BINDING_DIRECT, direct.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA16F);
@@ -88,6 +90,7 @@ void Baker::Impl::bakeSun() {
         for (int jy = 0; jy < j; ++jy)
             for (int jx = 0; jx < j; ++jx) {
                 const glm::vec2 jitter((jx + 0.5f) / j - 0.5f, (jy + 0.5f) / j - 0.5f);
+                footprintSample = uint32_t(jy * j + jx);
                 tracer->run(bundleFrame(glm::normalize(lights[li].direction), jitter, sunOptions.uniform, jitterUnit),
                             sunOptions, uint32_t(li * 1000 + jy * j + jx), false, update);
             }
@@ -129,13 +132,10 @@ int shadowCubeSize(const Baker::Impl& m) {
 // (its light uniforms set) over every page.
 void addVisibleLight(Baker::Impl& m, const gl::Program& program, const DistanceCube& cube) {
     const float pixelSize = m.pixelSize;
-    // the visibility test starts half a bundle pixel off the receiver. Bias: a
-    // quarter bundle pixel, plus (in the shader) half a cube texel's footprint
-    // at the receiver's distance, the error of a nearest lookup. Kept well
-    // under a texel so walls one texel thick still cast shadows.
-    glUniform1f(program.uniform("normalOffset"), 0.5f * pixelSize);
-    glUniform1f(program.uniform("distanceBias"), 0.25f * pixelSize);
-    glUniform1f(program.uniform("footprintPerDistance"), 1.0f / float(cube.size));
+    // the visibility test's tolerance along the ray (lib/cube_visibility.glsl):
+    // half a bundle pixel, well under a texel so walls one texel thick still cast shadows
+    glUniform1f(program.uniform("rayOffset"), 0.5f * pixelSize);
+    glUniform1i(program.uniform("cubeSize"), cube.size);
     glBindTextureUnit(0, cube.cube.id());
     glBindImageTexture(BINDING_SCRATCH_RG, m.accumAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32F);
     glBindImageTexture(BINDING_SCRATCH_B, m.radianceAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
@@ -178,13 +178,18 @@ void Baker::Impl::bakeEmitters() {
 
     DistanceCube cube(shadowCubeSize(*this), triangleBuffer.id(), int64_t(mesh.triangles.size()));
     const float nearPlane = 1e-4f * sphereRadius, farPlane = 4.0f * sphereRadius;
+    // one triangle's ratio sums at a time (direct/emitter.frag), for this pass only
+    const int res = layout.resolution;
+    gl::Texture sums = gl::Texture::create2DArray("emitter ratio sums", GL_RG32F, res, res, layout.pageCount);
+    const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    glClearTexImage(sums.id(), 0, GL_RG, GL_FLOAT, zero);
 
     for (const Emitter& e : emitters) {
         const BakeVertex* v = &mesh.vertices[e.triangle * 3];
         glm::vec3 a(v[0].position), b(v[1].position), c(v[2].position);
         glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
+        const float area = 0.5f * glm::length(glm::cross(b - a, c - a));
         bool doubleSided = mesh.triangles[e.triangle].flags & TRIANGLE_DOUBLE_SIDED;
-        glm::vec3 perSample = e.radiance / (float(e.samples) * radianceUnit);
         for (int i = 0; i < e.samples; ++i) {
             // stratified point on the triangle: R2 sequence (Roberts 2018), folded
             double su = std::fmod(0.5 + 0.7548776662466927 * (i + 1), 1.0);
@@ -202,12 +207,21 @@ void Baker::Impl::bakeEmitters() {
             glUniform3fv(emitterProgram.uniform("emitterB"), 1, &b.x);
             glUniform3fv(emitterProgram.uniform("emitterC"), 1, &c.x);
             glUniform3fv(emitterProgram.uniform("emitterNormal"), 1, &n.x);
+            glUniform1f(emitterProgram.uniform("emitterArea"), area);
             glUniform1i(emitterProgram.uniform("emitterDoubleSided"), doubleSided);
-            glUniform3fv(emitterProgram.uniform("radianceOverSamples"), 1, &perSample.x);
             glUniform3fv(emitterProgram.uniform("samplePoint"), 1, &point.x);
+            glBindImageTexture(BINDING_EMITTER_SUMS, sums.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32F);
+            glUniform1ui(emitterProgram.uniform("footprintSample"), uint32_t(stats.emitterSampleCount));
             addVisibleLight(*this, emitterProgram, cube);
             ++stats.emitterSampleCount;
         }
+        glUseProgram(emitterFoldProgram.id());
+        const glm::vec3 radiance = e.radiance / radianceUnit;
+        glUniform3fv(emitterFoldProgram.uniform("emitterRadiance"), 1, &radiance.x);
+        glBindImageTexture(BINDING_EMITTER_SUMS, sums.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32F);
+        glBindImageTexture(BINDING_SCRATCH_RG, accumAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32F);
+        glBindImageTexture(BINDING_SCRATCH_B, radianceAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
+        dispatchPages(emitterFoldProgram.id());
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }

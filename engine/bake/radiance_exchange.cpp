@@ -46,11 +46,16 @@ void Baker::Impl::beginDirection(int k) {
         glUniform1i(updateProgram.uniform("halfStride"), stats.noiseStride);
         glBindImageTexture(BINDING_HALF_ACCUM, halfAccum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
         glUniform1f(updateProgram.uniform("depthBias"), depthBias);
+        glUniform1ui(updateProgram.uniform("footprintSample"), uint32_t(k));
         if (useEnv) glBindTextureUnit(BINDING_ENV, envTexture.id());
         glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
         return updateProgram.id();
     };
-    tracer->begin(bundleFrame(d, glm::vec2(0.0f), tilerOptions.uniform, pixelSize), tilerOptions, seed, true);
+    // the grid's phase, random per direction: where the bundle grid beats against
+    // the light map's texels, the pattern moves from direction to direction and
+    // averages out instead of settling into stripes (issue 11)
+    const glm::vec2 phase(uniform01(pcgHash(seed ^ 0x5bd1e995u)) - 0.5f, uniform01(pcgHash(seed ^ 0x1b873593u)) - 0.5f);
+    tracer->begin(bundleFrame(d, phase, tilerOptions.uniform, pixelSize), tilerOptions, seed, true);
     directionActive = true;
 }
 

@@ -9,7 +9,11 @@
 // stays the front face.
 #include "layout/bake_mesh.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <numeric>
+#include <tuple>
 
 #include "core/check.h"
 
@@ -20,7 +24,56 @@ bool emits(const Material& material) {
     return material.emission.r > 0.0f || material.emission.g > 0.0f || material.emission.b > 0.0f;
 }
 
+// A triangle's edge in page space: end points' bits (a <= b), on its page.
+struct LightmapEdge {
+    uint32_t page;
+    uint64_t a, b;
+    uint32_t triangle;
+    int opposite;  // the vertex the edge faces
+};
+
+// Every edge, sorted so that edges sharing both end points are neighbours.
+std::vector<LightmapEdge> sortedLightmapEdges(const BakeMesh& mesh) {
+    auto key = [](glm::vec2 p) {
+        p += glm::vec2(0.0f);  // -0 as +0
+        uint32_t x, y;
+        std::memcpy(&x, &p.x, 4);
+        std::memcpy(&y, &p.y, 4);
+        return (uint64_t(x) << 32) | y;
+    };
+    std::vector<LightmapEdge> edges;
+    edges.reserve(3 * mesh.triangles.size());
+    for (size_t t = 0; t < mesh.triangles.size(); ++t)
+        for (int e = 0; e < 3; ++e) {
+            const uint64_t a = key(mesh.vertices[3 * t + size_t(e)].lightmapUv);
+            const uint64_t b = key(mesh.vertices[3 * t + size_t(e + 1) % 3].lightmapUv);
+            edges.push_back({mesh.triangles[t].page, std::min(a, b), std::max(a, b), uint32_t(t), (e + 2) % 3});
+        }
+    std::sort(edges.begin(), edges.end(), [](const LightmapEdge& x, const LightmapEdge& y) {
+        return std::tie(x.page, x.a, x.b, x.triangle) < std::tie(y.page, y.a, y.b, y.triangle);
+    });
+    return edges;
+}
+
+bool sameEdge(const LightmapEdge& x, const LightmapEdge& y) { return x.page == y.page && x.a == y.a && x.b == y.b; }
+
 }  // namespace
+
+std::vector<uint32_t> findLightmapCharts(const BakeMesh& mesh) {
+    const size_t n = mesh.triangles.size();
+    std::vector<uint32_t> parent(n);
+    std::iota(parent.begin(), parent.end(), 0u);
+    auto root = [&](uint32_t a) {
+        while (parent[a] != a) a = parent[a] = parent[parent[a]];
+        return a;
+    };
+    const std::vector<LightmapEdge> edges = sortedLightmapEdges(mesh);
+    for (size_t i = 1; i < edges.size(); ++i)
+        if (sameEdge(edges[i - 1], edges[i])) parent[root(edges[i - 1].triangle)] = root(edges[i].triangle);
+    std::vector<uint32_t> chart(n);
+    for (size_t t = 0; t < n; ++t) chart[t] = root(uint32_t(t));
+    return chart;
+}
 
 BakeMesh buildBakeMesh(const Scene& scene, const Layout& layout) {
     CHECK_EQ(layout.rects.size(), scene.instances.size());
@@ -108,6 +161,12 @@ BakeMesh buildBakeMesh(const Scene& scene, const Layout& layout) {
     }
     out.pageFirstTriangle = std::move(first);
     out.origin = scene.origin;
+    const std::vector<LightmapEdge> edges = sortedLightmapEdges(out);
+    for (size_t i = 0; i < edges.size(); ++i) {
+        const bool shared = (i > 0 && sameEdge(edges[i - 1], edges[i])) ||
+                            (i + 1 < edges.size() && sameEdge(edges[i], edges[i + 1]));
+        if (!shared) out.triangles[edges[i].triangle].flags |= TRIANGLE_CHART_BORDER0 << edges[i].opposite;
+    }
     return out;
 }
 

@@ -30,7 +30,7 @@ struct BakeTriangle {
     uint32_t material;    // index into Scene::materials
     uint32_t page;        // light map page
     uint32_t instance;    // index into Scene::instances
-    uint32_t flags;       // TRIANGLE_DOUBLE_SIDED, TRIANGLE_EMISSIVE
+    uint32_t flags;       // TRIANGLE_* (glsl/shared/mesh_layout.h)
 };
 static_assert(sizeof(BakeTriangle) == 16);
 
@@ -52,6 +52,12 @@ struct BakeMesh {
 // gives the same bytes as the untranslated one whenever T moves the origin by
 // T too (chooseLocalOrigin away from the world origin).
 // Precondition: layout was computed for this scene.
+// Sets TRIANGLE_CHART_BORDER0 << k on every edge no other triangle shares.
 BakeMesh buildBakeMesh(const Scene& scene, const Layout& layout);
+
+// Light map charts: triangles of one page joined by shared light map edges
+// (both end points bit-identical in page space, as buildBakeMesh copies them
+// from one source vertex). Returns a chart id per triangle.
+std::vector<uint32_t> findLightmapCharts(const BakeMesh& mesh);
 
 }  // namespace bb

@@ -354,49 +354,6 @@ Status ReferenceBaker::Impl::init(const Scene& scene) {
 
 namespace {
 
-// Light map charts: triangles of one page joined by shared light map edges
-// (both end points bit-identical in page space, as buildBakeMesh copies them
-// from one source vertex). Returns a chart id per triangle.
-std::vector<uint32_t> findCharts(const BakeMesh& mesh) {
-    const size_t n = mesh.triangles.size();
-    std::vector<uint32_t> parent(n);
-    std::iota(parent.begin(), parent.end(), 0u);
-    auto root = [&](uint32_t a) {
-        while (parent[a] != a) a = parent[a] = parent[parent[a]];
-        return a;
-    };
-    struct Edge {
-        uint32_t page;
-        uint64_t a, b;  // end points' bits, a <= b
-        uint32_t triangle;
-    };
-    auto key = [](glm::vec2 p) {
-        p += glm::vec2(0.0f);  // -0 as +0
-        uint32_t x, y;
-        std::memcpy(&x, &p.x, 4);
-        std::memcpy(&y, &p.y, 4);
-        return (uint64_t(x) << 32) | y;
-    };
-    std::vector<Edge> edges;
-    edges.reserve(3 * n);
-    for (size_t t = 0; t < n; ++t)
-        for (int e = 0; e < 3; ++e) {
-            uint64_t a = key(mesh.vertices[3 * t + size_t(e)].lightmapUv);
-            uint64_t b = key(mesh.vertices[3 * t + size_t(e + 1) % 3].lightmapUv);
-            edges.push_back({mesh.triangles[t].page, std::min(a, b), std::max(a, b), uint32_t(t)});
-        }
-    std::sort(edges.begin(), edges.end(), [](const Edge& x, const Edge& y) {
-        return std::tie(x.page, x.a, x.b, x.triangle) < std::tie(y.page, y.a, y.b, y.triangle);
-    });
-    for (size_t i = 1; i < edges.size(); ++i) {
-        const Edge &x = edges[i - 1], &y = edges[i];
-        if (x.page == y.page && x.a == y.a && x.b == y.b) parent[root(x.triangle)] = root(y.triangle);
-    }
-    std::vector<uint32_t> chart(n);
-    for (size_t t = 0; t < n; ++t) chart[t] = root(uint32_t(t));
-    return chart;
-}
-
 // The unit square clipped to a counter-clockwise triangle (Sutherland-Hodgman).
 std::vector<glm::dvec2> clipSquare(const glm::dvec2 (&tri)[3]) {
     std::vector<glm::dvec2> poly = {{0, 0}, {1, 0}, {1, 1}, {0, 1}}, next;
@@ -440,7 +397,7 @@ glm::dvec3 inset(glm::dvec3 w) {
 // (the square clipped to each of the chart's triangles).
 void ReferenceBaker::Impl::findTexels() {
     const int res = layout.resolution;
-    const std::vector<uint32_t> chart = findCharts(mesh);
+    const std::vector<uint32_t> chart = findLightmapCharts(mesh);
     for (int page = 0; page < layout.pageCount; ++page) {
         std::vector<uint32_t> order;
         for (uint32_t t = mesh.pageFirstTriangle[page]; t < mesh.pageFirstTriangle[page + 1]; ++t) order.push_back(t);

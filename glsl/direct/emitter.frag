@@ -1,47 +1,64 @@
 #version 450
-// Direct light from an emissive triangle, one of its visibility samples:
-// L_lm += Le * F(x -> triangle) * V(x, sample) / sampleCount, with F the exact
-// polygon form factor (no 1/r^2 noise near the emitter) and V read from the
-// sample's distance cube map. Adds to the direct light's float sums
-// (lib/direct_scratch.glsl).
+// Direct light from an emissive triangle, one of its visibility samples, at
+// the sample's point x of the texel's footprint (lib/texel_footprint.glsl:
+// over the samples, the texel's mean). The triangle's light is
+//   Le * F(x) * sum(r V) / sum(r),   r = w / mean(w),   w = cos_x cos_e / d^2
+// over its samples (direct/emitter_fold.comp divides once they are all in),
+// with F the exact polygon form factor (no 1/d^2 noise near the emitter),
+// mean(w) = pi F / A over the triangle (area A) and V the sample's visibility
+// from its distance cube map: a ratio estimate, exact where the triangle is
+// wholly seen and where it is wholly hidden (a sealed room stays 0), that
+// weighs each sample by what it brings. F times the fraction of samples seen
+// (as before) weighs every point of the emitter alike, but the part a
+// blocker hides is mostly the farther, more grazing one: penumbrae read
+// 20-50 % dark on the Cornell box (issue 11).
 #include "shared/bundle_layout.h"
+#include "shared/mesh_layout.h"
+#include "lib/rounding.glsl"
+#include "lib/texel_footprint.glsl"
 #include "lib/polygon_irradiance.glsl"
+#include "lib/cube_visibility.glsl"
 
 in vec3 vPosition;
 in vec3 vNormal;
+in vec3 vBary;
+flat in uint vFlags;
 
-#include "lib/direct_scratch.glsl"
-layout(binding = 0) uniform samplerCube distances;
+layout(binding = BINDING_EMITTER_SUMS, rg32f) uniform coherent image2DArray sums;  // (sum f r V, sum r)
 uniform vec3 emitterA, emitterB, emitterC;  // world vertices
 uniform vec3 emitterNormal;
+uniform float emitterArea;
 uniform bool emitterDoubleSided;
-uniform vec3 radianceOverSamples;         // Le / samples of this triangle
 uniform vec3 samplePoint;
-uniform float normalOffset;                // scene units: pushes x off its own surface
-uniform float distanceBias;                // scene units
-uniform float footprintPerDistance;        // half a cube texel's width per unit distance (1 / face size)
 uniform int page;
+uniform uint footprintSample;              // this emitter sample's index over all emitters
+
+const float PI = 3.14159265358979;
 
 void main() {
+    vec3 positionDx = dFdx(vPosition), positionDy = dFdy(vPosition);
+    vec3 normalDx = dFdx(vNormal), normalDy = dFdy(vNormal);
+    vec3 baryDx = dFdx(vBary), baryDy = dFdy(vBary);
     if (gl_HelperInvocation) return;
-    vec3 n = normalize(vNormal);
-    vec3 x = vPosition;
+    ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), page);
+    vec2 jitter = footprintOffset(vBary, baryDx, baryDy, vFlags, footprintSample);
+    vec3 n = normalize(vNormal + normalDx * jitter.x + normalDy * jitter.y);
+    vec3 x = vPosition + positionDx * jitter.x + positionDy * jitter.y;
     vec3 toX = x - samplePoint;
     // distance of x from the emitter's plane: behind a single-sided emitter
     // nothing arrives, and a point in the plane (the emitter's own texels, a
     // coplanar ceiling) gets nothing either: Lambert's formula would give it
     // the whole hemisphere (F = 1) from inside the polygon
     float facing = dot(emitterNormal, x - emitterA);
-    float planeEpsilon = 0.01 * normalOffset;
+    float planeEpsilon = 0.01 * rayOffset;
     if (emitterDoubleSided ? abs(facing) <= planeEpsilon : facing <= planeEpsilon) return;
-    if (dot(n, -toX) <= 0.0) return;                   // the sample is below x's horizon
-    // visibility from a point pushed off the surface (no self-shadowing); the
-    // form factor from the texel itself
-    vec3 shadowX = x + n * normalOffset - samplePoint;
-    float dist = length(shadowX);
-    float stored = texture(distances, shadowX).r;
-    if (dist > stored + distanceBias + footprintPerDistance * dist) return;  // occluded
     float f = polygonFormFactor(x, n, emitterA, emitterB, emitterC);
-    ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), page);
-    addDirect(texel, radianceOverSamples * f);
+    if (f <= 0.0) return;
+    // the sample's weight relative to the triangle's mean; below x's horizon 0
+    float r2 = dot(toX, toX);
+    float cosX = -dot(n, toX), cosE = abs(dot(emitterNormal, toX));
+    if (cosX <= 0.0) return;
+    float r = cosX * cosE / (r2 * r2) * emitterArea / (PI * f);
+    float seen = occludedFromLight(x, cross(positionDx, positionDy), samplePoint) ? 0.0 : 1.0;
+    imageStore(sums, texel, imageLoad(sums, texel) + vec4(f * r * seen, r, 0.0, 0.0));
 }

@@ -12,6 +12,11 @@
 // The material is a cut-out (alphaMode MASK): passes test its alpha at the
 // fragment (lib/alpha_mask.glsl); other triangles skip the lookup.
 #define TRIANGLE_ALPHA_MASK 8u
+// Edge k of the triangle (the one opposite vertex k) is a border of its light
+// map chart: no other triangle of the page shares it (both end points) in page
+// space. A texel's footprint ends there (lib/texel_footprint.glsl); across an
+// edge the chart shares, it goes on in the neighbour. Bit k: TRIANGLE_CHART_BORDER0 << k.
+#define TRIANGLE_CHART_BORDER0 16u
 
 // SSBO binding of BakeTriangle triangles[] (lib/bake_vertex.glsl), bound in
 // chunks by MeshChunks (engine/layout/bake_mesh_gl.h)

@@ -1,0 +1,48 @@
+// A point of a light map texel's footprint (issue 11: one definition of a
+// texel's value for the bake and the reference, engine/reference/reference_baker.h):
+// a texel holds the mean over the part of its square (page space) that lies on
+// its chart, so each sample of the update and direct passes starts at a point
+// spread over that part, not at the texel's centre. A fragment of the light
+// map raster (its centre inside its triangle) moves by an offset in texels
+// along the triangle's own plane: across an edge its chart shares the plane is
+// the neighbour's too where the chart is flat (and nearly so where it is
+// smooth); past a chart border (TRIANGLE_CHART_BORDER0 << k) the point is off
+// the surface and is drawn again.
+//
+// Sample i of a texel: point i of the R2 sequence (Roberts 2018), the same for
+// every texel, so that any run of consecutive samples is spread evenly over
+// the square, and a texel's samples depend on where it lies on its surface,
+// not on where its chart lies in the atlas (layouts of one density bake the
+// same values). Candidates off the chart are replaced by hashed ones (uniform
+// over the part on the chart, as rejection sampling is); after 8 the centre.
+//
+// Needs lib/rounding.glsl (pcgHash, uniform01) and shared/mesh_layout.h.
+
+// Whether the point `offset` texels from the fragment's centre lies off its
+// chart (past an edge that is a chart border). bary: the fragment's
+// barycentrics; baryDx, baryDy: their steps per texel (dFdx, dFdy).
+bool offChart(vec3 bary, vec3 baryDx, vec3 baryDy, uint flags, vec2 offset) {
+    uint borders = (flags / TRIANGLE_CHART_BORDER0) & 7u;
+    vec3 b = bary + baryDx * offset.x + baryDy * offset.y;
+    return ((borders & 1u) != 0u && b.x < 0.0) || ((borders & 2u) != 0u && b.y < 0.0) ||
+           ((borders & 4u) != 0u && b.z < 0.0);
+}
+
+// Offset in texels of sample `sampleIndex`'s point, each coordinate in [-0.5, 0.5).
+vec2 footprintOffset(vec3 bary, vec3 baryDx, vec3 baryDy, uint flags, uint sampleIndex) {
+    // R2 in 32-bit fixed point (alpha * 2^32, wrapping: exact for any index), from 0.5
+    uvec2 fixedPoint = uvec2(sampleIndex * 3242174889u, sampleIndex * 2447445413u) + 0x80000000u;
+    vec2 offset = vec2(fixedPoint >> 8u) * (1.0 / 16777216.0) - 0.5;
+    for (int attempt = 0; attempt < 8; ++attempt) {
+        if (!offChart(bary, baryDx, baryDy, flags, offset)) return offset;
+        uint h = pcgHash(sampleIndex * 8u + uint(attempt));
+        offset = vec2(uniform01(h), uniform01(pcgHash(h))) - 0.5;
+    }
+    return vec2(0.0);
+}
+
+// Barycentrics as a vertex output: vertex k of a (non-indexed) triangle is e_k.
+vec3 cornerBarycentric(int vertexId) {
+    int k = vertexId % 3;
+    return vec3(k == 0 ? 1.0 : 0.0, k == 1 ? 1.0 : 0.0, k == 2 ? 1.0 : 0.0);
+}
