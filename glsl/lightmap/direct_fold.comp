@@ -2,7 +2,7 @@
 // Folds the direct light's float sums (lib/direct_scratch.glsl) into the fp16
 // direct map and clears them: the emitters' sums are added as they are, the
 // sun's are divided by its valid sample count (the direct map's alpha, which
-// is reset), both kept non-negative. Stochastic rounding (or nearest), one rounding per fold.
+// is reset). Stochastic rounding (or nearest), one rounding per fold.
 #include "shared/bundle_layout.h"
 #include "lib/rounding.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -21,8 +21,6 @@ void main() {
     vec3 sum = vec3(imageLoad(scratchRg, t).rg, imageLoad(scratchB, t).r);
     vec4 d = imageLoad(directMap, t);
     if (perSample) sum = d.a > 0.0 ? sum / d.a : vec3(0.0);
-    // the emitters' estimate of their hidden part can overshoot by its noise in shadow
-    sum = max(sum, vec3(0.0));
     vec3 v = d.rgb + sum;
     uint h = pcgHash(randomSeed ^ pcgHash(uint(t.x) | (uint(t.y) << 16u)) ^ pcgHash(uint(t.z) + 104729u));
     uint h1 = pcgHash(h), h2 = pcgHash(h1);
