@@ -173,7 +173,7 @@ SeamStitchStats stitchSeams(LightmapPages& maps, const Seams& seams, const SeamS
     };
     const Eigen::Index n = Eigen::Index(texels.size());
 
-    // normal equations: (J^T J + keepWeight I) x = keepWeight x_baked
+    // normal equations: (J^T J + K) x = K x_baked, K the texels' keep weights
     std::vector<Eigen::Triplet<double>> triplets;
     triplets.reserve(rows.size() * 64 + size_t(n));
     for (size_t r = 0; r < rows.size(); ++r)
@@ -181,7 +181,15 @@ SeamStitchStats stitchSeams(LightmapPages& maps, const Seams& seams, const SeamS
             for (int j = 0; j < rowSize[r]; ++j)
                 triplets.emplace_back(var(rows[r][size_t(i)].key), var(rows[r][size_t(j)].key),
                                       rows[r][size_t(i)].weight * rows[r][size_t(j)].weight);
-    for (Eigen::Index i = 0; i < n; ++i) triplets.emplace_back(i, i, options.keepWeight);
+    // covered texels hold what the bake measured (their footprints' means): they
+    // move coveredKeepFactor times less than the padding texels the seams' lookups tap
+    Eigen::VectorXd keep(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+        const uint64_t key = texels[size_t(i)];
+        const bool covered = maps.covered[size_t(key >> 40)][size_t(key & ((uint64_t(1) << 40) - 1))];
+        keep(i) = options.keepWeight * (covered ? options.coveredKeepFactor : 1.0);
+        triplets.emplace_back(i, i, keep(i));
+    }
     Eigen::SparseMatrix<double> a(n, n);
     a.setFromTriplets(triplets.begin(), triplets.end());
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(a);
@@ -197,7 +205,7 @@ SeamStitchStats stitchSeams(LightmapPages& maps, const Seams& seams, const SeamS
         baked(i, 1) = v.g;
         baked(i, 2) = v.b;
     }
-    const Eigen::MatrixXd x = solver.solve(baked * options.keepWeight);
+    const Eigen::MatrixXd x = solver.solve(keep.asDiagonal() * baked);
     if (solver.info() != Eigen::Success) {
         st.solved = false;
         return st;

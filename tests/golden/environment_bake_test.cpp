@@ -129,7 +129,11 @@ std::vector<FaceResult> checkLinearFaces(const char* who, const Scene& scene, co
 // one texel, update.frag): the mean is cosine-weighted over the hemisphere
 // minus a band at its horizon (~2 % of the weight would do it), which leans
 // towards the normal; a uniform sky cannot show this, a gradient does.
-// Tolerance: face mean 5 %, every texel 8 %; L(n) + L(-n) = 2a within 0.5 %
+// Samples spread over each texel's footprint (issue 11) put the edge texels'
+// points nearer the face's edge, where more grazing samples cross the plane
+// past it: the worst texel reads 8.6 % (seed 1; 7.0 % at the texels' centres),
+// the face means do not move.
+// Tolerance: face mean 5 %, every texel 10 %; L(n) + L(-n) = 2a within 0.5 %
 // (the +-d pairing makes opposite faces complementary; measured 0.00 %).
 // A mirrored or rotated lookup moves some face by 9..70 % and flips the
 // sign check. Reference (256 samples a texel, cosine-weighted, stratified):
@@ -150,7 +154,7 @@ TEST(EnvironmentBake, LinearEnvironmentOnRotatedBoxIsAnalytic) {
     auto gpu = bakeGpu(scene, *layout, options, &seconds);
     ASSERT_TRUE(gpu) << gpu.error();
     std::printf("[env] GPU bake: %.2f s\n", seconds);
-    std::vector<FaceResult> g = checkLinearFaces("bundlebake", scene, *layout, *gpu, 0.05, 0.08);
+    std::vector<FaceResult> g = checkLinearFaces("bundlebake", scene, *layout, *gpu, 0.05, 0.10);
     for (int f = 0; f < 6; f += 2)
         for (int c = 0; c < 3; ++c)
             EXPECT_NEAR(g[size_t(f)].mean[c] + g[size_t(f) + 1].mean[c], 2.0 * A, 0.005 * 2.0 * A)

@@ -82,8 +82,9 @@ TEST(SeamStitch, StepAcrossSeamIsStitchedAndTheRestKept) {
     ASSERT_TRUE(st.solved);
     EXPECT_NEAR(st.rmsBefore, 1.0, 1e-9);
     EXPECT_NEAR(st.meanValue, 1.5, 1e-9);
-    // keepWeight 0.1: the step shrinks by about 19x (measured 0.0531)
-    EXPECT_LT(st.rmsAfter, 0.06 * st.rmsBefore) << st.toJson().dump();
+    // every texel covered: keepWeight 0.1 x coveredKeepFactor 3, the step
+    // shrinks by about 9x (measured 0.112; 0.053 when covered texels moved as freely as padding)
+    EXPECT_LT(st.rmsAfter, 0.13 * st.rmsBefore) << st.toJson().dump();
     EXPECT_EQ(st.samplePairs, 24u);
     // columns 3, 4 and 11, 12 of rows 1..10 (the lookups' taps)
     EXPECT_EQ(st.texelsAdjusted, 2u * 2u * 10u);
