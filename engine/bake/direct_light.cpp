@@ -179,7 +179,9 @@ void Baker::Impl::bakeEmitters() {
 
     DistanceCube cube(shadowCubeSize(*this), triangleBuffer.id(), int64_t(mesh.triangles.size()));
     const float nearPlane = 1e-4f * sphereRadius, farPlane = 4.0f * sphereRadius;
-    // one triangle's ratio sums at a time (direct/emitter.frag), for this pass only
+    // one triangle's ratio sums at a time (direct/emitter.frag), for this pass
+    // only: 8 bytes a texel while the bundle pass's buffers are still small,
+    // within the budget's share for them
     const int res = layout.resolution;
     gl::Texture sums = gl::Texture::create2DArray("emitter ratio sums", GL_RG32F, res, res, layout.pageCount);
     const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
