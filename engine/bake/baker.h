@@ -55,7 +55,7 @@ struct BakeOptions {
     Rounding rounding = Rounding::Stochastic;
     // History ramp: direction k is weighted min(k, directions/2)^power, so early
     // directions (which saw light maps with few bounces) fade out. < 0 = from
-    // the scene's largest albedo: round(2 rho / (1 - rho)), clamped to [1, 32].
+    // the scene's largest albedo: round(2 rho / (1 - rho)^1.5), clamped to [1, 1024].
     float historyPower = -1.0f;
     // Cut each tile until its predicted node count (projected cluster areas /
     // pixel area) fits 80 % of the budget's node buffer, and size the buffer

@@ -204,7 +204,7 @@ inline double furnaceExpectation(double le, double rho, int directions, double h
     const double rampEnd = std::max(1, directions / 2);
     double sum = 0, weights = 0, m = 0, r = 0;
     for (int k = 0; k < directions; ++k) {
-        // relative to the ramp's last weight: powers up to 256 stay in range
+        // relative to the ramp's last weight (early ones underflow to 0 at large powers)
         const double w = std::exp(historyPower * (std::log(std::min(double(k + 1), rampEnd)) - std::log(rampEnd)));
         sum += w * (le + rho * r);
         weights += w;
@@ -217,7 +217,7 @@ inline double furnaceExpectation(double le, double rho, int directions, double h
 // The baker's default history power for a largest albedo rho (BakeOptions::historyPower < 0).
 inline double defaultHistoryPower(double rho) {
     rho = std::min(rho, 0.99);
-    return std::clamp(std::round(2.0 * rho / (1.0 - rho)), 1.0, 256.0);
+    return std::clamp(std::round(2.0 * rho / std::pow(1.0 - rho, 1.5)), 1.0, 1024.0);
 }
 
 // --- texels to triangles (CPU) ----------------------------------------------
