@@ -63,6 +63,13 @@ struct DistanceCube {
     }
 };
 
+// The direct light's float sums (lib/direct_scratch.glsl): views of the
+// accumulators and the radiance map, unused while the direct light is baked.
+void bindDirectSums(const Baker::Impl& m) {
+    glBindImageTexture(BINDING_SCRATCH_RG, m.accumAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32F);
+    glBindImageTexture(BINDING_SCRATCH_B, m.radianceAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
+}
+
 }  // namespace
 
 void Baker::Impl::bakeSun() {
@@ -83,8 +90,7 @@ void Baker::Impl::bakeSun() {
             glUniform3fv(sunProgram.uniform("sunIrradiance"), 1, &irradiance.x);
             glUniform1f(sunProgram.uniform("depthBias"), depthBias);
             glUniform1ui(sunProgram.uniform("footprintSample"), footprintSample);
-            glBindImageTexture(BINDING_SCRATCH_RG, accumAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32F);
-            glBindImageTexture(BINDING_SCRATCH_B, radianceAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
+            bindDirectSums(*this);
             glBindImageTexture(BINDING_DIRECT, direct.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA16F);
             return sunProgram.id();
         };
@@ -138,8 +144,7 @@ void addVisibleLight(Baker::Impl& m, const gl::Program& program, const DistanceC
     glUniform1f(program.uniform("rayOffset"), 0.5f * pixelSize);
     glUniform1i(program.uniform("cubeSize"), cube.size);
     glBindTextureUnit(0, cube.cube.id());
-    glBindImageTexture(BINDING_SCRATCH_RG, m.accumAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32F);
-    glBindImageTexture(BINDING_SCRATCH_B, m.radianceAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
+    bindDirectSums(m);
     glBindFramebuffer(GL_FRAMEBUFFER, m.pageFbo.id());
     glViewport(0, 0, m.layout.resolution, m.layout.resolution);
     const std::vector<uint32_t>& first = m.mesh.pageFirstTriangle;
@@ -186,6 +191,7 @@ void Baker::Impl::bakeEmitters() {
     gl::Texture sums = gl::Texture::create2DArray("emitter ratio sums", GL_RG32F, res, res, layout.pageCount);
     const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     glClearTexImage(sums.id(), 0, GL_RG, GL_FLOAT, zero);
+    glBindImageTexture(BINDING_EMITTER_SUMS, sums.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32F);
 
     for (const Emitter& e : emitters) {
         const BakeVertex* v = &mesh.vertices[e.triangle * 3];
@@ -213,7 +219,6 @@ void Baker::Impl::bakeEmitters() {
             glUniform1f(emitterProgram.uniform("emitterArea"), area);
             glUniform1i(emitterProgram.uniform("emitterDoubleSided"), doubleSided);
             glUniform3fv(emitterProgram.uniform("samplePoint"), 1, &point.x);
-            glBindImageTexture(BINDING_EMITTER_SUMS, sums.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32F);
             glUniform1ui(emitterProgram.uniform("footprintSample"), uint32_t(stats.emitterSampleCount));
             addVisibleLight(*this, emitterProgram, cube);
             ++stats.emitterSampleCount;
@@ -221,9 +226,7 @@ void Baker::Impl::bakeEmitters() {
         glUseProgram(emitterFoldProgram.id());
         const glm::vec3 radiance = e.radiance / radianceUnit;
         glUniform3fv(emitterFoldProgram.uniform("emitterRadiance"), 1, &radiance.x);
-        glBindImageTexture(BINDING_EMITTER_SUMS, sums.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32F);
-        glBindImageTexture(BINDING_SCRATCH_RG, accumAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32F);
-        glBindImageTexture(BINDING_SCRATCH_B, radianceAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
+        bindDirectSums(*this);
         dispatchPages(emitterFoldProgram.id());
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -265,8 +268,7 @@ void Baker::Impl::foldDirect(bool perSample) {
     glUseProgram(directFoldProgram.id());
     glUniform1i(directFoldProgram.uniform("perSample"), perSample);
     glUniform1ui(directFoldProgram.uniform("randomSeed"), pcgHash(uint32_t(options.seed) ^ (perSample ? 0x51u : 0xE4u)));
-    glBindImageTexture(BINDING_SCRATCH_RG, accumAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32F);
-    glBindImageTexture(BINDING_SCRATCH_B, radianceAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
+    bindDirectSums(*this);
     glBindImageTexture(BINDING_DIRECT, direct.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA16F);
     dispatchPages(directFoldProgram.id());
 }

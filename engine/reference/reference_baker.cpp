@@ -9,11 +9,8 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <cstring>
 #include <limits>
-#include <numeric>
 #include <thread>
-#include <tuple>
 
 #include <embree3/rtcore.h>
 #if defined(__SSE__) || defined(__x86_64__)
