@@ -150,10 +150,11 @@ void Baker::Impl::uploadMesh() {
     vao = createBakeVertexArray("bake vertex array", vertexBuffer);
 }
 
-void Baker::Impl::dispatchPages(GLuint program) {
-    glUniform1i(glGetUniformLocation(program, "pageCount"), layout.pageCount);
+void Baker::Impl::dispatchPages(GLuint program, int layers) {
+    if (layers == 0) layers = layout.pageCount;
+    glUniform1i(glGetUniformLocation(program, "pageCount"), layers);
     glUniform2i(glGetUniformLocation(program, "pageSize"), layout.resolution, layout.resolution);
-    glDispatchCompute((layout.resolution + 7) / 8, (layout.resolution + 7) / 8, layout.pageCount);
+    glDispatchCompute((layout.resolution + 7) / 8, (layout.resolution + 7) / 8, layers);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
 }
 
@@ -163,7 +164,7 @@ void Baker::Impl::rescaleAccumulators(float factor, uint32_t seed) {
     glUniform1f(rescaleProgram.uniform("factor"), factor);
     glUniform1ui(rescaleProgram.uniform("randomSeed"), seed);
     glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
-    dispatchPages(rescaleProgram.id());
+    dispatchPages(rescaleProgram.id(), stateLayers());
     glBindImageTexture(BINDING_ACCUM, halfAccum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
     glUniform2i(rescaleProgram.uniform("pageSize"), halfWidth, halfWidth);
     glDispatchCompute(GLuint(halfWidth + 7) / 8, GLuint(halfWidth + 7) / 8, GLuint(layout.pageCount));
@@ -337,9 +338,13 @@ Status Baker::Impl::init(const Scene& scene) {
     if (layout.resolution > maxTex)
         return Status::error("--resolution " + std::to_string(layout.resolution) + " exceeds GL_MAX_TEXTURE_SIZE " +
                              std::to_string(maxTex));
-    if (layout.pageCount > maxLayers)
-        return Status::error(std::to_string(layout.pageCount) + " light map pages exceed GL_MAX_ARRAY_TEXTURE_LAYERS " +
-                             std::to_string(maxLayers) + "; raise --resolution or lower --texel-density");
+    for (const BakeTriangle& t : mesh.triangles)
+        if (t.flags & TRIANGLE_DOUBLE_SIDED) backLayerOffset = layout.pageCount;
+    if (stateLayers() > maxLayers)
+        return Status::error(std::to_string(layout.pageCount) + " light map pages" +
+                             (backLayerOffset ? " (twice over: double-sided materials)" : "") +
+                             " exceed GL_MAX_ARRAY_TEXTURE_LAYERS " + std::to_string(maxLayers) +
+                             "; raise --resolution or lower --texel-density");
 
     // scene frame: bounding sphere of the bounds box
     sphereCenter = mesh.bounds.center();
@@ -426,8 +431,8 @@ Status Baker::Impl::init(const Scene& scene) {
     const int pages = layout.pageCount, res = layout.resolution;
     {
         MemoryCategory category("light maps");
-        accum = gl::Texture::create2DArray("accumulators (fp16 RGB + W)", GL_RG32UI, res, res, pages);
-        radiance = gl::Texture::create2DArray("outgoing radiance (RGB9E5)", GL_RGB9_E5, res, res, pages);
+        accum = gl::Texture::create2DArray("accumulators (fp16 RGB + W)", GL_RG32UI, res, res, stateLayers());
+        radiance = gl::Texture::create2DArray("outgoing radiance (RGB9E5)", GL_RGB9_E5, res, res, stateLayers());
         direct = gl::Texture::create2DArray("direct light (fp16)", GL_RGBA16F, res, res, pages);
         dilation = gl::Texture::create2DArray("dilation codes", GL_R8UI, res, res, pages);
         accumAsFloat = gl::Texture::createView("accumulators as rg32f (direct light sums)", accum, GL_RG32F);
@@ -510,7 +515,7 @@ Status Baker::Impl::init(const Scene& scene) {
         // the bundle pass: its buffers start small and grow to what the tiles predict
         MemoryCategory category("bundles");
         const BundleScene scene{&mesh, &clusters, vao.id(), vertexBuffer.id(), triangleBuffer.id(), radiance.id(),
-                                pageFbo.id(), res, materialAlphaBuffer.id(), alphaTexelBuffer.id()};
+                                pageFbo.id(), res, materialAlphaBuffer.id(), alphaTexelBuffer.id(), backLayerOffset};
         const BundleLimits limits{nodeCapacity, maxTileSize, subpixelBits, options.predictTiles};
         auto t = BundleTracer::create(scene, limits,
                                       options.rounding == Rounding::Nearest ? "#define ROUNDING_NEAREST 1\n" : "", &stats);

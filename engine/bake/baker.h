@@ -44,9 +44,10 @@ struct BakeOptions {
     // grid over the whole scene at the mean texel density, cut into tiles.
     enum class Tiling { Adaptive, Uniform } tiling = Tiling::Adaptive;
     bool cull = true;                 // per tile, draw only the clusters whose bounds meet it (both passes)
-    // GL bytes for the whole bake: light-map state (21 bytes a page texel), mesh
-    // (172 bytes a triangle), materials, and what is left for one tile's node
-    // buffer and head image. A bake that does not fit fails at create().
+    // GL bytes for the whole bake: light-map state (21 bytes a page texel, 33
+    // with double-sided materials), mesh (172 bytes a triangle), materials, and
+    // what is left for one tile's node buffer and head image. A bake that does
+    // not fit fails at create().
     int64_t memoryBudget = 4ll << 30;
     int64_t bundleMemory = 0;         // > 0: one tile's node buffer + head image exactly (tests); 0 = what the budget leaves
     uint64_t seed = 1;

@@ -50,7 +50,7 @@ struct Baker::Impl {
     // GL objects
     gl::Buffer vertexBuffer, triangleBuffer, metaIndexBuffer;
     gl::VertexArray vao;
-    // Light-map state, per page texel (21 bytes; BakeStats::memory):
+    // Light-map state, per page texel (21 bytes, 33 with back sides; BakeStats::memory):
     //   accum      RG32UI  the running mean of incoming radiance (fp16 RGB) and its weight (fp16)
     //   radiance   RGB9_E5 outgoing radiance Lo the bundle pass samples (meta.frag writes it)
     //   direct     RGBA16F direct light L_lm (sun + explicit emitters)
@@ -58,7 +58,13 @@ struct Baker::Impl {
     // While the direct light is baked, its float sums live in views of accum
     // and radiance (lib/direct_scratch.glsl). Albedo and emission are not
     // stored: the outgoing pass reads them from the materials.
+    // Double-sided triangles light both sides differently (a panel light under a
+    // ceiling: its back reflects the ceiling's light onto it again), so a scene
+    // with any has accum and radiance twice over: page p's back sides at layer
+    // p + backLayerOffset (12 more bytes a texel; the direct light stays front-only).
     gl::Texture accum, radiance, direct, dilation;
+    int backLayerOffset = 0;  // 0: no double-sided triangles, one layer per page
+    int stateLayers() const { return layout.pageCount + backLayerOffset; }  // accum's and radiance's layers
     gl::Texture accumAsFloat, radianceBits, radianceAsFloat;  // views: rg32f, r32ui, r32f
     gl::Texture resolved;  // the whole light map L_lm, made on first use (the viewer's)
     // the noise estimate (noise.cpp): the odd directions' accumulators at every
@@ -139,7 +145,7 @@ struct Baker::Impl {
     void refreshRadiance(uint32_t key);  // key: the direction just done (random numbers)
     // L_lm of the region (x 0.., y0.., page) + (width, rows, pages) into `target` at (0, 0, 0).
     void resolveInto(const gl::Texture& target, int y0, int rows, int page0, int pages);
-    void dispatchPages(GLuint program);
+    void dispatchPages(GLuint program, int layers = 0);  // layers: 0 = the pages
     // The accumulators' weights times `factor` (both the whole's and the noise half's).
     void rescaleAccumulators(float factor, uint32_t seed);
     void clearAccumulators();  // both to zero: no sample (a share's bakers other than 0 after a combine)

@@ -142,6 +142,7 @@ void BundleTracer::next(const UpdateFn& update) {
         setFrameUniforms(append_.id(), f);
         glUniform1ui(append_.uniform("nodeCapacity"), uint32_t(nodeAllocated_));
         glUniform1ui(append_.uniform("randomSeed"), leafSeed);
+        glUniform1i(append_.uniform("backLayerOffset"), scene_.backLayerOffset);
         // the leaf's grid in a power-of-two viewport (glsl/bundle/append.vert) shifted so the
         // tile lands at (0, 0); the scissor keeps the rest out
         int viewportPixels = 1;

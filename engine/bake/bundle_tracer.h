@@ -52,6 +52,7 @@ struct BundleScene {
     int pageResolution = 0;
     // cut-outs (glsl/shared/material_layout.h): per material alpha and the masks' texels
     GLuint materialAlpha = 0, alphaTexels = 0;
+    int backLayerOffset = 0;  // > 0: double-sided triangles' back sides' radiance at layer page + this
 };
 
 struct BundleLimits {

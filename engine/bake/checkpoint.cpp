@@ -143,9 +143,9 @@ Status Baker::saveCheckpoint(const std::string& path) {
         }
     }
     const int res = m.layout.resolution;
-    const int pages = m.layout.pageCount;
-    std::vector<glm::uvec2> raw(size_t(res) * res * pages);
-    gl::readTexture(m.accum.id(), 0, 0, 0, res, res, pages, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
+    const int pages = m.layout.pageCount, layers = m.stateLayers();
+    std::vector<glm::uvec2> raw(size_t(res) * res * layers);
+    gl::readTexture(m.accum.id(), 0, 0, 0, res, res, layers, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
     CheckpointHeader h{};
     std::memcpy(h.magic, CHECKPOINT_MAGIC, 8);
     h.key = checkpointKey(m);
@@ -155,7 +155,7 @@ Status Baker::saveCheckpoint(const std::string& path) {
     h.accumLogScale = m.accumLogScale;
     // the radiance map too: it is refreshed on a schedule, so it can be older than the accumulators
     std::vector<uint32_t> radiance(raw.size());  // RGB9E5 bits
-    gl::readTexture(m.radianceBits.id(), 0, 0, 0, res, res, pages, GL_RED_INTEGER, GL_UNSIGNED_INT, 4, radiance.data());
+    gl::readTexture(m.radianceBits.id(), 0, 0, 0, res, res, layers, GL_RED_INTEGER, GL_UNSIGNED_INT, 4, radiance.data());
     // and the noise estimate's half
     std::vector<glm::uvec2> half(size_t(m.halfWidth) * m.halfWidth * pages);
     gl::readTexture(m.halfAccum.id(), 0, 0, 0, m.halfWidth, m.halfWidth, pages, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, half.data());
@@ -179,7 +179,7 @@ Status Baker::loadCheckpoint(const std::string& path) {
     if (!f) return Status::error("cannot read checkpoint " + path);
     CheckpointHeader h{};
     const int res = m.layout.resolution;
-    const size_t texels = size_t(res) * res * m.layout.pageCount;
+    const size_t texels = size_t(res) * res * m.stateLayers();
     const size_t halfTexels = size_t(m.halfWidth) * m.halfWidth * m.layout.pageCount;
     const size_t mapBytes = sizeof h + texels * (sizeof(glm::uvec2) + sizeof(uint32_t)) + halfTexels * sizeof(glm::uvec2);
     // every way a file can fail to be this layout's checkpoint, said before anything is read into GL
@@ -230,8 +230,8 @@ Status Baker::loadCheckpoint(const std::string& path) {
     if (h.directionsDone < 0 || h.directionsDone > m.options.directions ||
         (h.directionsDone % m.shareCount() != 0 && h.directionsDone != m.options.directions))
         return Status::error(path + ": corrupt progress count");
-    gl::writeTexture(m.accum.id(), 0, 0, 0, res, res, m.layout.pageCount, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
-    gl::writeTexture(m.radianceBits.id(), 0, 0, 0, res, res, m.layout.pageCount, GL_RED_INTEGER, GL_UNSIGNED_INT, 4,
+    gl::writeTexture(m.accum.id(), 0, 0, 0, res, res, m.stateLayers(), GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
+    gl::writeTexture(m.radianceBits.id(), 0, 0, 0, res, res, m.stateLayers(), GL_RED_INTEGER, GL_UNSIGNED_INT, 4,
                      radiance.data());
     gl::writeTexture(m.halfAccum.id(), 0, 0, 0, m.halfWidth, m.halfWidth, m.layout.pageCount, GL_RG_INTEGER,
                      GL_UNSIGNED_INT, 8, half.data());

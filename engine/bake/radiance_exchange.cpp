@@ -44,6 +44,7 @@ void Baker::Impl::beginDirection(int k) {
         // two independently rotated sets (bake/directions.h)
         glUniform1i(updateProgram.uniform("oddDirection"), k % 2);
         glUniform1i(updateProgram.uniform("halfStride"), stats.noiseStride);
+        glUniform1i(updateProgram.uniform("backLayerOffset"), backLayerOffset);
         glBindImageTexture(BINDING_HALF_ACCUM, halfAccum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
         glUniform1f(updateProgram.uniform("depthBias"), depthBias);
         glUniform1ui(updateProgram.uniform("footprintSample"), uint32_t(k));
@@ -119,8 +120,9 @@ void Baker::Impl::combineShares(int round) {
     const double logScale = rampLogWeight(round);
     const float toCommon = float(std::exp(accumLogScale - logScale));
     // the whole's accumulators, then the noise estimate's half
-    const auto combine = [&](const gl::Texture& texture, int width, const std::vector<std::vector<uint32_t>>& coveredIndex,
-                             uint32_t salt) {
+    // (a double-sided scene's back sides' layers follow their page's covered texels)
+    const auto combine = [&](const gl::Texture& texture, int width, int layers,
+                             const std::vector<std::vector<uint32_t>>& coveredIndex, uint32_t salt) {
         const size_t pageTexels = size_t(width) * width;
         const auto rnd = [&](size_t texel, uint32_t channel) {
             return uniform01(pcgHash(uint32_t(options.seed) ^ pcgHash(uint32_t(texel) * 4u + channel) ^
@@ -128,8 +130,8 @@ void Baker::Impl::combineShares(int round) {
         };
         std::vector<glm::uvec2> raw(pageTexels);
         std::vector<float> sums;
-        for (int p = 0; p < layout.pageCount; ++p) {
-            const std::vector<uint32_t>& covered = coveredIndex[size_t(p)];
+        for (int p = 0; p < layers; ++p) {
+            const std::vector<uint32_t>& covered = coveredIndex[size_t(p % layout.pageCount)];
             gl::readTexture(texture.id(), 0, 0, p, width, width, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
             sums.assign(covered.size() * 4, 0.0f);
             for (size_t i = 0; i < covered.size(); ++i) {
@@ -156,8 +158,8 @@ void Baker::Impl::combineShares(int round) {
             gl::writeTexture(texture.id(), 0, 0, p, width, width, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
         }
     };
-    combine(accum, res, coveredTexelIndex, 0x68e31da4u);
-    combine(halfAccum, halfWidth, halfCoveredTexelIndex, 0x2545f491u);
+    combine(accum, res, stateLayers(), coveredTexelIndex, 0x68e31da4u);
+    combine(halfAccum, halfWidth, layout.pageCount, halfCoveredTexelIndex, 0x2545f491u);
     accumLogScale = logScale;
     ++stats.combines;
 }
@@ -170,11 +172,17 @@ void Baker::Impl::refreshRadiance(uint32_t key) {
     glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RG32UI);
     glBindImageTexture(BINDING_DIRECT, direct.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
     glBindImageTexture(BINDING_RADIANCE_BITS, radianceBits.id(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32UI);
+    glUniform1i(metaProgram.uniform("layerOffset"), 0);
     drawSurface(metaProgram.id(), true);
+    if (backLayerOffset != 0) {  // the back sides' layers
+        glUniform1i(metaProgram.uniform("layerOffset"), backLayerOffset);
+        drawSurface(metaProgram.id(), true);
+    }
     glUseProgram(dilateProgram.id());
+    glUniform1i(dilateProgram.uniform("codePages"), layout.pageCount);
     glBindImageTexture(BINDING_DILATION, dilation.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_R8UI);
     glBindImageTexture(BINDING_RADIANCE_BITS, radianceBits.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32UI);
-    dispatchPages(dilateProgram.id());
+    dispatchPages(dilateProgram.id(), stateLayers());
 }
 
 void Baker::Impl::resolveInto(const gl::Texture& target, int y0, int rows, int page0, int pages) {

@@ -230,7 +230,9 @@ std::vector<ClusterView> projectClusters(const BakeMesh& mesh, const std::vector
         for (uint32_t t = c.first; t < c.first + c.count; ++t) {
             glm::dvec3 a(mesh.vertices[3 * size_t(t)].position), b(mesh.vertices[3 * size_t(t) + 1].position),
                 cc(mesh.vertices[3 * size_t(t) + 2].position);
-            area += 0.5 * std::abs(glm::dot(glm::cross(b - a, cc - a), d));
+            // a double-sided fragment can be two nodes (its sides' radiance, glsl/bundle/append.frag)
+            const double sides = (mesh.triangles[t].flags & TRIANGLE_DOUBLE_SIDED) ? 2.0 : 1.0;
+            area += sides * 0.5 * std::abs(glm::dot(glm::cross(b - a, cc - a), d));
         }
         views[i].projectedArea = area;
     }

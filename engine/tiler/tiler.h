@@ -80,7 +80,7 @@ struct BundleFrame {
 // A cluster seen along one direction.
 struct ClusterView {
     glm::dvec4 rect{0.0};       // (u0, v0, u1, v1) in root units ([0,1] spans the root square)
-    double projectedArea = 0;   // sum of A(t) |n(t).d|, scene units^2
+    double projectedArea = 0;   // sum of A(t) |n(t).d| (double-sided: twice, up to two nodes), scene units^2
 };
 
 // Per cluster, its bounds' rectangle and projected area along frame.dir. O(T).

@@ -27,6 +27,7 @@ layout(binding = BINDING_RADIANCE) uniform sampler2DArray radiance;
 
 uniform uint nodeCapacity;
 uniform uint randomSeed;  // per direction and leaf (not per tile: tiles change with the budget, the bytes must not)
+uniform int backLayerOffset;  // > 0: double-sided triangles' back sides' radiance at layer page + backLayerOffset
 
 void main() {
     ivec2 pixel = ivec2(gl_FragCoord.xy);  // in the tile (the head image)
@@ -36,19 +37,37 @@ void main() {
     if ((vFlags & TRIANGLE_ALPHA_MASK) != 0u &&
         alphaCut(vMaterial, vec2(dot(vUv0XPlane.xy, centre) + vUv0XPlane.z, dot(vUv0YPlane.xy, centre) + vUv0YPlane.z)))
         return;
-    uint index = atomicCounterIncrement(nodeCounter);
-    if (index >= nodeCapacity) return;  // overflow: the host sees counter > capacity and redraws split
     float depth = dot(vDepthPlane.xy, centre) + vDepthPlane.z;
     vec2 lightmapUv = vec2(dot(vUPlane.xy, centre) + vUPlane.z, dot(vVPlane.xy, centre) + vVPlane.z);
-    vec3 lo = textureLod(radiance, vec3(lightmapUv, float(vPage)), 0.0).rgb;
     uint h = pcgHash(randomSeed ^ pcgHash(uint(leafPixel.x) + 65536u * uint(leafPixel.y)) ^ pcgHash(vTriangle + 0x9E3779B9u));
     vec3 u = vec3(uniform01(h), uniform01(pcgHash(h)), uniform01(pcgHash(h + 1u)));
-    uint flags;
-    if ((vFlags & TRIANGLE_DOUBLE_SIDED) != 0u)
-        flags = NODE_VISIBLE_FROM_BEHIND | NODE_VISIBLE_FROM_AHEAD;
-    else
-        flags = dot(vFaceNormal, bundleDir) < 0.0 ? NODE_VISIBLE_FROM_BEHIND : NODE_VISIBLE_FROM_AHEAD;
-    nodes[index].radiance = encodeRgbe(lo, u);
-    nodes[index].depth = (floatBitsToUint(depth) & ~NODE_FLAG_MASK) | flags;
+    // the side the triangle's front faces (its texels' side, update.frag)
+    uint front = dot(vFaceNormal, bundleDir) < 0.0 ? NODE_VISIBLE_FROM_BEHIND : NODE_VISIBLE_FROM_AHEAD;
+    uint radianceFront = encodeRgbe(textureLod(radiance, vec3(lightmapUv, float(vPage)), 0.0).rgb, u);
+    uint back = NODE_FLAG_MASK & ~front;
+    bool twoSides = (vFlags & TRIANGLE_DOUBLE_SIDED) != 0u;
+    // a double-sided surface: its back side's own radiance, in a second node at
+    // the same depth where it differs (the same depth bits: update.frag tells
+    // them apart by their sides)
+    uint radianceBack = radianceFront;
+    if (twoSides && backLayerOffset > 0)
+        radianceBack = encodeRgbe(textureLod(radiance, vec3(lightmapUv, float(int(vPage) + backLayerOffset)), 0.0).rgb, u);
+    uint depthBits = floatBitsToUint(depth) & ~NODE_FLAG_MASK;
+    if (!twoSides || radianceBack == radianceFront) {
+        uint index = atomicCounterIncrement(nodeCounter);
+        if (index >= nodeCapacity) return;  // overflow: the host sees counter > capacity and redraws split
+        nodes[index].radiance = radianceFront;
+        nodes[index].depth = depthBits | (twoSides ? NODE_FLAG_MASK : front);
+        nodes[index].next = imageAtomicExchange(heads, pixel, index);
+        return;
+    }
+    uint index = atomicCounterIncrement(nodeCounter);
+    uint indexBack = atomicCounterIncrement(nodeCounter);
+    if (max(index, indexBack) >= nodeCapacity) return;
+    nodes[index].radiance = radianceFront;
+    nodes[index].depth = depthBits | front;
+    nodes[indexBack].radiance = radianceBack;
+    nodes[indexBack].depth = depthBits | back;
     nodes[index].next = imageAtomicExchange(heads, pixel, index);
+    nodes[indexBack].next = imageAtomicExchange(heads, pixel, indexBack);
 }

@@ -8,7 +8,9 @@
 // accumulators' running mean (the indirect light, see update.frag) + the direct
 // map, stochastically rounded into the RGB9E5 radiance map the bundle pass
 // samples. Albedo and emission come from the material here, every pass, so no
-// texel stores them. dilate.comp then fills the padding.
+// texel stores them. dilate.comp then fills the padding. Run again with
+// layerOffset > 0 for double-sided triangles' back sides (their own running
+// means; no direct light: the direct map is the front's).
 #include "shared/bundle_layout.h"
 #include "lib/rounding.glsl"
 
@@ -37,6 +39,7 @@ uniform bool hasAlbedoTexture;
 uniform bool hasEmissionTexture;
 uniform bool includeEmission;  // false when emitters are lit explicitly: bundles then carry reflected light only
 uniform uint randomSeed;       // per refresh
+uniform int layerOffset;       // 0: the front sides; else the back sides' layers (page + layerOffset)
 
 void main() {
     // texture() before any branch: implicit derivatives need the whole quad
@@ -44,12 +47,12 @@ void main() {
     if (hasAlbedoTexture) a *= texture(albedoTexture, vUv0).rgb;
     vec3 e = emission;
     if (hasEmissionTexture) e *= texture(emissionTexture, vUv0).rgb;
-    ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), page);
+    ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), page + layerOffset);
     uvec2 p = imageLoad(accum, texel).rg;
     vec3 l = halfToFloat(p.y >> 16u) > 0.0 ? vec3(halfToFloat(p.x), halfToFloat(p.x >> 16u), halfToFloat(p.y)) : vec3(0.0);
-    l += imageLoad(directMap, texel).rgb;
+    if (layerOffset == 0) l += imageLoad(directMap, texel).rgb;
     vec3 lo = (includeEmission ? e : vec3(0.0)) + clamp(a, 0.0, 1.0) * l;
-    uint h = pcgHash(randomSeed ^ pcgHash(uint(texel.x) | (uint(texel.y) << 16u)) ^ pcgHash(uint(page) + 7919u));
+    uint h = pcgHash(randomSeed ^ pcgHash(uint(texel.x) | (uint(texel.y) << 16u)) ^ pcgHash(uint(texel.z) + 7919u));
     uint h1 = pcgHash(h), h2 = pcgHash(h1);
     imageStore(radianceBits, texel, uvec4(encodeRgb9e5(lo, vec3(uniform01(h), uniform01(h1), uniform01(h2)))));
 }

@@ -49,6 +49,7 @@ uniform uint randomSeed;
 layout(binding = BINDING_HALF_ACCUM, rg32ui) uniform coherent uimage2DArray halfAccum;
 uniform bool oddDirection;
 uniform int halfStride;
+uniform int backLayerOffset;  // > 0: double-sided triangles' back sides' accumulators at layer page + this
 #endif
 uniform uint nodeCount;      // nodes in this tile's lists (END_OF_LIST is larger)
 uniform float depthBias;      // scene units: float precision floor
@@ -70,7 +71,24 @@ vec3 environment(vec3 dir) {
 #endif
 }
 
+// Node i at depth z is nearer than the best so far along the walk (forward:
+// +d), or as near and preferred: seen from the looking side (a double-sided
+// surface's two nodes share a depth), then the brighter (so any order of the
+// list picks the same node).
+bool nearer(uint i, float z, uint bestNode, float best, bool forward, uint seen) {
+    if (bestNode == END_OF_LIST || z != best) return forward ? z < best : z > best;
+    bool visible = (nodes[i].depth & seen) != 0u, bestVisible = (nodes[bestNode].depth & seen) != 0u;
+    return visible != bestVisible ? visible : nodes[i].radiance > nodes[bestNode].radiance;
+}
+
 #ifndef SUN_PASS
+// L_in from node i seen from side `seen` (a back face is black), or the
+// environment looking along `look` where nothing is there.
+vec3 incomingRadiance(uint i, uint seen, vec3 look) {
+    if (i == END_OF_LIST) return environment(look);
+    return (nodes[i].depth & seen) != 0u ? decodeRgbe(nodes[i].radiance) : vec3(0.0);
+}
+
 // `stored` (fp16 running mean M, weight W) with L_in folded in at weight w:
 // W += w, M += (L_in - M) w / W, rounded with the random numbers of h.
 uvec2 foldSample(uvec2 stored, vec3 incoming, float w, uint h) {
@@ -166,7 +184,7 @@ void main() {
     if (distance(crossing, position) > reach) return;  // beyond one texel
     // `i < nodeCount` rather than `!= END_OF_LIST`: ends on any stray index too
     for (uint i = imageLoad(heads, pixel).r; i < nodeCount; i = nodes[i].next) {
-        float z = uintBitsToFloat(nodes[i].depth);
+        float z = uintBitsToFloat(nodes[i].depth & ~NODE_FLAG_MASK);  // the depth without its side flags
         float dz = abs(z - planeDepth);
         if (dz <= tolerance && (nodes[i].depth & ownSide) != 0u && dz < selfDistance) {
             selfDistance = dz;
@@ -176,15 +194,26 @@ void main() {
     if (selfDistance > tolerance) return;
     float start = self + (ahead ? depthBias : -depthBias);
 
-    float best = ahead ? 3.0e38 : -3.0e38;
-    uint bestNode = END_OF_LIST;
+    // The nearest node past the start along the look, and (a double-sided
+    // triangle with back sides of its own) the nearest the other way, which its
+    // back side sees along the same line at the same cosine.
+#ifdef SUN_PASS
+    bool twoSides = false;
+#else
+    bool twoSides = backLayerOffset > 0 && (vFlags & TRIANGLE_DOUBLE_SIDED) != 0u;
+#endif
+    float backStart = self + (ahead ? -depthBias : depthBias);
+    float best = ahead ? 3.0e38 : -3.0e38, bestBack = -best;
+    uint bestNode = END_OF_LIST, bestBackNode = END_OF_LIST;
     for (uint i = imageLoad(heads, pixel).r; i < nodeCount; i = nodes[i].next) {
-        float z = uintBitsToFloat(nodes[i].depth);
-        bool inFront = ahead ? (z > start && (z < best || (z == best && nodes[i].radiance > nodes[bestNode].radiance)))
-                             : (z < start && (z > best || (z == best && nodes[i].radiance > nodes[bestNode].radiance)));
-        if (inFront) {
+        float z = uintBitsToFloat(nodes[i].depth & ~NODE_FLAG_MASK);  // the depth without its side flags
+        if ((ahead ? z > start : z < start) && nearer(i, z, bestNode, best, ahead, seenSide)) {
             best = z;
             bestNode = i;
+        }
+        if (twoSides && (ahead ? z < backStart : z > backStart) && nearer(i, z, bestBackNode, bestBack, !ahead, ownSide)) {
+            bestBack = z;
+            bestBackNode = i;
         }
     }
 
@@ -196,17 +225,16 @@ void main() {
     vec4 d = imageLoad(directMap, texel);
     imageStore(directMap, texel, vec4(d.rgb, d.a + 1.0));
 #else
-    vec3 incoming;
-    if (bestNode == END_OF_LIST) {
-        incoming = environment(ahead ? bundleDir : -bundleDir);
-    } else {
-        bool visible = (nodes[bestNode].depth & seenSide) != 0u;
-        incoming = visible ? decodeRgbe(nodes[bestNode].radiance) : vec3(0.0);  // a back face is black
-    }
+    vec3 incoming = incomingRadiance(bestNode, seenSide, ahead ? bundleDir : -bundleDir);
     // the running cosine-weighted mean of L_in (rgb) and its weight W (a)
     float w = sampleWeight * cosine;
     uint h = pcgHash(randomSeed ^ pcgHash(uint(texel.x) | (uint(texel.y) << 16u)) ^ pcgHash(vPage + 7919u));
     imageStore(accum, texel, uvec4(foldSample(imageLoad(accum, texel).rg, incoming, w, h), 0u, 0u));
+    if (twoSides) {
+        ivec3 back = ivec3(texel.xy, texel.z + backLayerOffset);
+        vec3 incomingBack = incomingRadiance(bestBackNode, ownSide, ahead ? -bundleDir : bundleDir);
+        imageStore(accum, back, uvec4(foldSample(imageLoad(accum, back).rg, incomingBack, w, pcgHash(h ^ 0x85ebca6bu)), 0u, 0u));
+    }
     if (oddDirection && texel.x % halfStride == 0 && texel.y % halfStride == 0) {
         ivec3 half_ = ivec3(texel.xy / halfStride, texel.z);
         imageStore(halfAccum, half_, uvec4(foldSample(imageLoad(halfAccum, half_).rg, incoming, w, pcgHash(h ^ 0x9e3779b9u)), 0u, 0u));
