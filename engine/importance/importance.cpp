@@ -123,7 +123,8 @@ Importance computeImportance(std::span<const BakeVertex> vertices, std::span<con
             const glm::vec2 uv[3] = {v[0].lightmapUv, v[1].lightmapUv, v[2].lightmapUv};
             float m = 0.0f;
             rasterizeTriangle(uv, resolution, rules, [&](int x, int y, const glm::dvec3&) {
-                m = std::max(m, density[size_t(y) * resolution + x]);
+                const float d = density[size_t(y) * resolution + x];
+                m = std::max(m, d > 0.0f ? d : NO_DENSITY_ESTIMATE);
             });
             out.maxDensity[t] = m;
         }
@@ -131,7 +132,7 @@ Importance computeImportance(std::span<const BakeVertex> vertices, std::span<con
     // compute pass: Eq. (1) and Eq. (4)
     for (size_t t = 0; t < triangleCount; ++t) {
         out.areaRatio[t] = areaRatio(&vertices[t * 3], resolution);
-        out.importance[t] = std::min(out.areaRatio[t], out.maxDensity[t]);
+        out.importance[t] = triangleImportance(out.areaRatio[t], out.maxDensity[t]);
     }
     return out;
 }

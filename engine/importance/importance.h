@@ -6,6 +6,12 @@
 //   Eq. (1)  A_l(t) / A_o(t)                               (triangle area ratio)
 //   Eq. (3)  I(x) = sum w(x_i) / sum w(x_i) |e_i|^2        (4-neighbour texel density)
 //   Eq. (4)  I(t) = min(A_l(t)/A_o(t), I_max(t)),  I_max(t) = max_{x in t} I(x)
+// One addition: a texel centre with no Eq. (3) estimate (no mapped neighbour:
+// a chart too small for two texel centres, common on finely tessellated
+// assets) gives I_max(t) = NO_DENSITY_ESTIMATE, and Eq. (4) then takes the
+// triangle's own A_l/A_o (0 when that is not finite either). Without it such
+// a triangle read I(t) = 0, "covers no texel centre", and its texel was never
+// baked: black on the chair of mixed_lighting.
 //
 // Units: I is light map texels per world area (texels / scene unit^2), so the
 // bundle pixel a triangle needs is 1/sqrt(I) scene units wide (DESIGN.md
@@ -56,13 +62,23 @@ struct PositionBuffer {
 struct Importance {
     std::vector<float> importance;  // I(t), Eq. (4): texels per scene unit^2
     std::vector<float> areaRatio;   // A_l(t)/A_o(t), Eq. (1) (MAX_AREA_RATIO when A_o = 0 < A_l)
-    std::vector<float> maxDensity;  // I_max(t): max of Eq. (3) over the texel centres t covers; 0 if none
+    std::vector<float> maxDensity;  // I_max(t): max of Eq. (3) over the texel centres t covers; 0 if none,
+                                    // NO_DENSITY_ESTIMATE if one of them has no estimate
     size_t size() const { return importance.size(); }
 };
 
 // Stand-in for Eq. (1)'s +infinity when a triangle has light map area but no
 // world area (A_o = 0 in float): Eq. (4) then takes I_max(t).
 inline constexpr float MAX_AREA_RATIO = 3.402823466e38f;  // FLT_MAX
+
+// I_max(t) of a triangle covering a texel centre with no Eq. (3) estimate
+// (texelDensity 0): Eq. (4) takes A_l/A_o where that is below MAX_AREA_RATIO, else 0.
+inline constexpr float NO_DENSITY_ESTIMATE = 3.402823466e38f;  // FLT_MAX: wins every maximum
+// Eq. (4) with that convention (clamp.comp mirrors it).
+inline float triangleImportance(float areaRatio, float maxDensity) {
+    if (maxDensity == NO_DENSITY_ESTIMATE) return areaRatio < MAX_AREA_RATIO ? areaRatio : 0.0f;
+    return areaRatio < maxDensity ? areaRatio : maxDensity;
+}
 
 // Eq. (1) for one triangle: A_l/A_o with A_l in texels^2 of a page of
 // `resolution` texels and A_o in world units^2. Conventions that keep it

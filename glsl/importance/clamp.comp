@@ -1,6 +1,8 @@
 #version 450
 // Importance compute pass: Eq. (4) per triangle,
 //   I(t) = min(A_l(t) / A_o(t), I_max(t)),
+// or A_l / A_o (0 if not finite) where a centre t covers had no estimate
+// (I_max = IMPORTANCE_NO_DENSITY_ESTIMATE: triangleImportance() in importance.h),
 // A_o in world units^2, A_l in texels^2. Conventions (as areaRatio() in
 // engine/importance/importance.cpp): A_l = 0 -> ratio 0; A_o = 0 < A_l ->
 // IMPORTANCE_MAX_AREA_RATIO, so I(t) = I_max(t). One invocation per triangle
@@ -34,5 +36,8 @@ void main() {
     }
     float maxDensity = uintBitsToFloat(maxDensityBits[t]);
     areaRatio[t] = ratio;
-    importance[t] = min(ratio, maxDensity);
+    if (maxDensity == IMPORTANCE_NO_DENSITY_ESTIMATE)
+        importance[t] = ratio < float(IMPORTANCE_MAX_AREA_RATIO) ? ratio : 0.0;
+    else
+        importance[t] = min(ratio, maxDensity);
 }

@@ -42,7 +42,8 @@ void main() {
     if (!(density <= FLT_MAX)) density = 0.0;
     // most fragments of a triangle do not raise its maximum: a plain read
     // first skips their atomics (values only grow, so skipping is safe)
-    uint bits = floatBitsToUint(density);
+    // no estimate: the triangle's own A_l / A_o (IMPORTANCE_NO_DENSITY_ESTIMATE, clamp.comp)
+    uint bits = floatBitsToUint(density > 0.0 ? density : IMPORTANCE_NO_DENSITY_ESTIMATE);
     uint t = vTriangle - meshChunkFirstTriangle;
     if (bits > maxDensityBits[t]) atomicMax(maxDensityBits[t], bits);
     if (writeDensity) imageStore(densityImage, x, vec4(density));

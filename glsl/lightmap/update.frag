@@ -130,7 +130,14 @@ void main() {
     jitter *= clamp(1.0 - pixelSize / (max(facing, 1e-3) * max(texelSize, 1e-30)), 0.0, 1.0);
 #endif
     vec3 position = vPosition + positionDx * jitter.x + positionDy * jitter.y;
-    vec3 n = normalize(vNormal + normalDx * jitter.x + normalDy * jitter.y);
+    // the shading normal where the point leaves the triangle, not extrapolated
+    // past it: a triangle far smaller than a texel (300 to a texel on the
+    // chair of mixed_lighting) would swing it by tens of degrees
+    vec3 baryStep = baryDx * jitter.x + baryDy * jitter.y;
+    float inside = 1.0;
+    for (int k = 0; k < 3; ++k)
+        if (baryStep[k] < 0.0) inside = min(inside, max(vBary[k], 0.0) / -baryStep[k]);
+    vec3 n = normalize(vNormal + (normalDx * jitter.x + normalDy * jitter.y) * inside);
     // the triangle's plane, on the side the bundle pass gives its fragments
     // (lib/triangle_side.glsl; the flag is computed with the mesh)
     vec3 ng = n;
@@ -182,6 +189,15 @@ void main() {
     float selfDistance = 3.0e38;
     vec3 crossing = position - bundleU * offset.x - bundleV * offset.y + bundleDir * (planeDepth - b.z);
     if (distance(crossing, position) > reach) return;  // beyond one texel
+    // On a curved surface the crossing lies on this triangle's plane, which the
+    // neighbouring facets leave by about curvature x r^2 / 2 at r from it (the
+    // triangles of a finely tessellated chair are smaller than a bundle pixel:
+    // their own fragments are mostly another facet's); the curvature from the
+    // shading normals' change across the texel (0 on flat charts, where the
+    // tolerance stays tight).
+    float curvature = max(length(normalDx) / max(length(positionDx), 1e-30), length(normalDy) / max(length(positionDy), 1e-30));
+    float r = distance(crossing, vPosition);
+    tolerance += min(0.5 * curvature * r * r / abs(cg), 0.5 * texelSize);
     // `i < nodeCount` rather than `!= END_OF_LIST`: ends on any stray index too
     for (uint i = imageLoad(heads, pixel).r; i < nodeCount; i = nodes[i].next) {
         float z = uintBitsToFloat(nodes[i].depth & ~NODE_FLAG_MASK);  // the depth without its side flags

@@ -26,5 +26,7 @@
 #define IMPORTANCE_GROUP_SIZE 64
 // Eq. (1) when A_o = 0 < A_l (FLT_MAX; engine/importance/importance.h MAX_AREA_RATIO)
 #define IMPORTANCE_MAX_AREA_RATIO 3.402823466e38
+// I_max(t) where a texel centre t covers has no Eq. (3) estimate (engine/importance/importance.h NO_DENSITY_ESTIMATE)
+#define IMPORTANCE_NO_DENSITY_ESTIMATE 3.402823466e38
 
 #endif

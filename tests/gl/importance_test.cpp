@@ -457,10 +457,13 @@ TEST(ImportanceGl, SingularNeighbourhoodsStayFinite) {
     EXPECT_EQ(gpu->importance.areaRatio[collinear], MAX_AREA_RATIO);  // A_o = 0 < A_l: Eq. (4) takes I_max
     EXPECT_GT(gpu->importance.maxDensity[collinear], 0.0f);
     EXPECT_EQ(gpu->importance.importance[collinear], gpu->importance.maxDensity[collinear]);
-    EXPECT_EQ(gpu->importance.maxDensity[point], 0.0f);  // every neighbour at the same position: no estimate
+    // every neighbour at the same position: no estimate, and A_o = 0: nothing finite to take
+    EXPECT_EQ(gpu->importance.maxDensity[point], NO_DENSITY_ESTIMATE);
     EXPECT_EQ(gpu->importance.importance[point], 0.0f);
-    EXPECT_EQ(gpu->importance.maxDensity[isolated], 0.0f);  // no neighbour: no estimate
-    EXPECT_EQ(gpu->importance.importance[isolated], 0.0f);
+    // no neighbour: no estimate; it covers a texel centre, so it takes its own A_l / A_o
+    EXPECT_EQ(gpu->importance.maxDensity[isolated], NO_DENSITY_ESTIMATE);
+    EXPECT_GT(gpu->importance.areaRatio[isolated], 0.0f);
+    EXPECT_EQ(gpu->importance.importance[isolated], gpu->importance.areaRatio[isolated]);
     crossCheck(mesh, R, "singular cases");
 }
 

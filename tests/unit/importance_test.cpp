@@ -269,10 +269,14 @@ TEST(ImportanceCpu, DegenerateTrianglesGiveNoNonFiniteValues) {
     EXPECT_EQ(imp.areaRatio[8], MAX_AREA_RATIO);
     EXPECT_GT(imp.maxDensity[8], 0.0f);
     EXPECT_EQ(imp.importance[8], imp.maxDensity[8]);
-    EXPECT_EQ(imp.importance[9], 0.0f);   // point: every |e| = 0, no estimate
+    EXPECT_EQ(imp.maxDensity[9], NO_DENSITY_ESTIMATE);  // point: every |e| = 0, no estimate,
+    EXPECT_EQ(imp.importance[9], 0.0f);                 // and A_o = 0: nothing finite to take
     EXPECT_EQ(imp.areaRatio[10], 0.0f);   // no light map area
     EXPECT_EQ(imp.importance[10], 0.0f);
-    EXPECT_EQ(imp.importance[11], 0.0f);  // isolated: no neighbour
+    // isolated: no neighbour, no estimate; it covers a texel centre, so it takes its own A_l / A_o
+    EXPECT_EQ(imp.maxDensity[11], NO_DENSITY_ESTIMATE);
+    EXPECT_GT(imp.areaRatio[11], 0.0f);
+    EXPECT_EQ(imp.importance[11], imp.areaRatio[11]);
     const PositionBuffer buffer = rasterizePositionBuffer(mesh.vertices, 0, uint32_t(mesh.triangles.size()), R);
     for (int y = 0; y < R; ++y)
         for (int x = 0; x < R; ++x)
