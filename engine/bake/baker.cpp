@@ -119,7 +119,7 @@ Status Baker::Impl::buildPrograms() {
         std::vector<std::string> files;
         std::string defines;
     } specs[] = {
-        {&updateProgram, {"lightmap/update.vert", "lightmap/update.frag"}, rounding},
+        {&updateProgram, {"lightmap/update.vert", "lightmap/update.frag"}, rounding + backSidesDefine()},
         {&sunProgram, {"lightmap/update.vert", "lightmap/update.frag"}, "#define SUN_PASS 1\n"},
         {&resolveProgram, {"lightmap/resolve.comp"}, ""},
         {&rescaleProgram, {"lightmap/rescale.comp"}, rounding},
@@ -517,8 +517,9 @@ Status Baker::Impl::init(const Scene& scene) {
         const BundleScene scene{&mesh, &clusters, vao.id(), vertexBuffer.id(), triangleBuffer.id(), radiance.id(),
                                 pageFbo.id(), res, materialAlphaBuffer.id(), alphaTexelBuffer.id(), backLayerOffset};
         const BundleLimits limits{nodeCapacity, maxTileSize, subpixelBits, options.predictTiles};
-        auto t = BundleTracer::create(scene, limits,
-                                      options.rounding == Rounding::Nearest ? "#define ROUNDING_NEAREST 1\n" : "", &stats);
+        auto t = BundleTracer::create(
+            scene, limits, (options.rounding == Rounding::Nearest ? "#define ROUNDING_NEAREST 1\n" : "") + backSidesDefine(),
+            &stats);
         if (!t) return t.status();
         tracer = std::move(t.value());
     }

@@ -27,7 +27,7 @@ layout(binding = BINDING_RADIANCE) uniform sampler2DArray radiance;
 
 uniform uint nodeCapacity;
 uniform uint randomSeed;  // per direction and leaf (not per tile: tiles change with the budget, the bytes must not)
-uniform int backLayerOffset;  // > 0: double-sided triangles' back sides' radiance at layer page + backLayerOffset
+uniform int backLayerOffset;  // BACK_SIDES: double-sided triangles' back sides' radiance at layer page + backLayerOffset
 
 void main() {
     ivec2 pixel = ivec2(gl_FragCoord.xy);  // in the tile (the head image)
@@ -44,30 +44,33 @@ void main() {
     // the side the triangle's front faces (its texels' side, update.frag)
     uint front = dot(vFaceNormal, bundleDir) < 0.0 ? NODE_VISIBLE_FROM_BEHIND : NODE_VISIBLE_FROM_AHEAD;
     uint radianceFront = encodeRgbe(textureLod(radiance, vec3(lightmapUv, float(vPage)), 0.0).rgb, u);
-    uint back = NODE_FLAG_MASK & ~front;
+    // A double-sided surface is seen from both sides: one node for both where
+    // they look the same, else a second node at the same depth for its back
+    // side's own radiance (update.frag tells the two apart by their sides).
     bool twoSides = (vFlags & TRIANGLE_DOUBLE_SIDED) != 0u;
-    // a double-sided surface: its back side's own radiance, in a second node at
-    // the same depth where it differs (the same depth bits: update.frag tells
-    // them apart by their sides)
     uint radianceBack = radianceFront;
-    if (twoSides && backLayerOffset > 0)
-        radianceBack = encodeRgbe(textureLod(radiance, vec3(lightmapUv, float(int(vPage) + backLayerOffset)), 0.0).rgb, u);
+#ifdef BACK_SIDES
+    // (only built for scenes with back sides: llvmpipe runs the fetch of a
+    // branch no lane takes, 25 % of the pass)
+    if (twoSides) {
+        vec3 lo = textureLod(radiance, vec3(lightmapUv, float(int(vPage) + backLayerOffset)), 0.0).rgb;
+        radianceBack = encodeRgbe(lo, u);
+    }
+#endif
     uint depthBits = floatBitsToUint(depth) & ~NODE_FLAG_MASK;
-    if (!twoSides || radianceBack == radianceFront) {
+    uint frontFlags = twoSides ? NODE_FLAG_MASK : front;
+    uint nodeCount = 1u;
+    if (radianceBack != radianceFront) {
+        frontFlags = front;
+        nodeCount = 2u;
+    }
+    // one site of each atomic, in a loop (llvmpipe runs an atomic's lane loop
+    // wherever one is written, whether a lane takes it or not)
+    for (uint k = 0u; k < nodeCount; ++k) {
         uint index = atomicCounterIncrement(nodeCounter);
         if (index >= nodeCapacity) return;  // overflow: the host sees counter > capacity and redraws split
-        nodes[index].radiance = radianceFront;
-        nodes[index].depth = depthBits | (twoSides ? NODE_FLAG_MASK : front);
+        nodes[index].radiance = k == 0u ? radianceFront : radianceBack;
+        nodes[index].depth = depthBits | (k == 0u ? frontFlags : NODE_FLAG_MASK & ~front);
         nodes[index].next = imageAtomicExchange(heads, pixel, index);
-        return;
     }
-    uint index = atomicCounterIncrement(nodeCounter);
-    uint indexBack = atomicCounterIncrement(nodeCounter);
-    if (max(index, indexBack) >= nodeCapacity) return;
-    nodes[index].radiance = radianceFront;
-    nodes[index].depth = depthBits | front;
-    nodes[indexBack].radiance = radianceBack;
-    nodes[indexBack].depth = depthBits | back;
-    nodes[index].next = imageAtomicExchange(heads, pixel, index);
-    nodes[indexBack].next = imageAtomicExchange(heads, pixel, indexBack);
 }

@@ -14,6 +14,10 @@
 //   2048 samples rounds by more than a sample is worth: 1.2 % rms per texel
 //   at 4096 directions in the furnace, against 0.03 % for the mean).
 //
+// Double-sided triangles (BACK_SIDES): the walk also takes the
+// nearest node the other way, which the texel's back side sees, into the back
+// side's own accumulator (baker_impl.h).
+//
 // SUN_PASS (define): the same walk along the sun's direction; a texel facing
 // the sun adds (nothing in front ? irradiance * cos / pi : 0) to the direct
 // light's float sums (lib/direct_scratch.glsl) and 1 to its sample count (the
@@ -49,7 +53,7 @@ uniform uint randomSeed;
 layout(binding = BINDING_HALF_ACCUM, rg32ui) uniform coherent uimage2DArray halfAccum;
 uniform bool oddDirection;
 uniform int halfStride;
-uniform int backLayerOffset;  // > 0: double-sided triangles' back sides' accumulators at layer page + this
+uniform int backLayerOffset;  // BACK_SIDES: double-sided triangles' back sides' accumulators at layer page + this
 #endif
 uniform uint nodeCount;      // nodes in this tile's lists (END_OF_LIST is larger)
 uniform float depthBias;      // scene units: float precision floor
@@ -71,15 +75,35 @@ vec3 environment(vec3 dir) {
 #endif
 }
 
-// Node i at depth z is nearer than the best so far along the walk (forward:
-// +d), or as near and preferred: seen from the looking side (a double-sided
-// surface's two nodes share a depth), then the brighter (so any order of the
-// list picks the same node).
-bool nearer(uint i, float z, uint bestNode, float best, bool forward, uint seen) {
-    if (bestNode == END_OF_LIST || z != best) return forward ? z < best : z > best;
-    bool visible = (nodes[i].depth & seen) != 0u, bestVisible = (nodes[bestNode].depth & seen) != 0u;
-    return visible != bestVisible ? visible : nodes[i].radiance > nodes[bestNode].radiance;
+// Of two nodes at the same depth, whether node i is preferred to node j:
+// seen from the looking side (a double-sided surface's two nodes share a
+// depth), then the brighter (so any order of the list picks the same node).
+bool preferred(uint i, uint j, uint seen) {
+#ifdef BACK_SIDES
+    bool visible = (nodes[i].depth & seen) != 0u, otherVisible = (nodes[j].depth & seen) != 0u;
+    if (visible != otherVisible) return visible;
+#endif
+    return nodes[i].radiance > nodes[j].radiance;
 }
+
+// The nearest node of `pixel`'s list past depth `start` along +d (forward)
+// or -d; at equal depth the one seen from side `seen`, then the brighter (a
+// double-sided surface's two nodes share a depth; any order of the list picks
+// the same node). END_OF_LIST: none.
+uint nearestNode(ivec2 pixel, float start, bool forward, uint seen) {
+    float best = forward ? 3.0e38 : -3.0e38;
+    uint bestNode = END_OF_LIST;
+    for (uint i = imageLoad(heads, pixel).r; i < nodeCount; i = nodes[i].next) {
+        float z = uintBitsToFloat(nodes[i].depth & ~NODE_FLAG_MASK);  // the depth without its side flags
+        // (ties are rare: the loads of `preferred` only run for them)
+        if (forward ? (z > start && z <= best) : (z < start && z >= best)) {
+            if (z != best || preferred(i, bestNode, seen)) bestNode = i;
+            best = z;
+        }
+    }
+    return bestNode;
+}
+
 
 #ifndef SUN_PASS
 // L_in from node i seen from side `seen` (a back face is black), or the
@@ -195,7 +219,8 @@ void main() {
     // their own fragments are mostly another facet's); the curvature from the
     // shading normals' change across the texel (0 on flat charts, where the
     // tolerance stays tight).
-    float curvature = max(length(normalDx) / max(length(positionDx), 1e-30), length(normalDy) / max(length(positionDy), 1e-30));
+    float curvature = max(length(normalDx) / max(length(positionDx), 1e-30),
+                          length(normalDy) / max(length(positionDy), 1e-30));
     float r = distance(crossing, vPosition);
     tolerance += min(0.5 * curvature * r * r / abs(cg), 0.5 * texelSize);
     // `i < nodeCount` rather than `!= END_OF_LIST`: ends on any stray index too
@@ -210,28 +235,7 @@ void main() {
     if (selfDistance > tolerance) return;
     float start = self + (ahead ? depthBias : -depthBias);
 
-    // The nearest node past the start along the look, and (a double-sided
-    // triangle with back sides of its own) the nearest the other way, which its
-    // back side sees along the same line at the same cosine.
-#ifdef SUN_PASS
-    bool twoSides = false;
-#else
-    bool twoSides = backLayerOffset > 0 && (vFlags & TRIANGLE_DOUBLE_SIDED) != 0u;
-#endif
-    float backStart = self + (ahead ? -depthBias : depthBias);
-    float best = ahead ? 3.0e38 : -3.0e38, bestBack = -best;
-    uint bestNode = END_OF_LIST, bestBackNode = END_OF_LIST;
-    for (uint i = imageLoad(heads, pixel).r; i < nodeCount; i = nodes[i].next) {
-        float z = uintBitsToFloat(nodes[i].depth & ~NODE_FLAG_MASK);  // the depth without its side flags
-        if ((ahead ? z > start : z < start) && nearer(i, z, bestNode, best, ahead, seenSide)) {
-            best = z;
-            bestNode = i;
-        }
-        if (twoSides && (ahead ? z < backStart : z > backStart) && nearer(i, z, bestBackNode, bestBack, !ahead, ownSide)) {
-            bestBack = z;
-            bestBackNode = i;
-        }
-    }
+    uint bestNode = nearestNode(pixel, start, ahead, seenSide);
 
 #ifdef SUN_PASS
     // the sun pass's d is the light's travel direction: a texel facing the sun looks along -d
@@ -246,11 +250,19 @@ void main() {
     float w = sampleWeight * cosine;
     uint h = pcgHash(randomSeed ^ pcgHash(uint(texel.x) | (uint(texel.y) << 16u)) ^ pcgHash(vPage + 7919u));
     imageStore(accum, texel, uvec4(foldSample(imageLoad(accum, texel).rg, incoming, w, h), 0u, 0u));
-    if (twoSides) {
+#ifdef BACK_SIDES
+    // A double-sided triangle's back side: the nearest node the other way,
+    // which it sees along the same line at the same cosine, into its own
+    // accumulator (only built for scenes with back sides: llvmpipe runs the
+    // loads of a branch no lane takes).
+    if ((vFlags & TRIANGLE_DOUBLE_SIDED) != 0u) {
+        uint bestBackNode = nearestNode(pixel, self + (ahead ? -depthBias : depthBias), !ahead, ownSide);
         ivec3 back = ivec3(texel.xy, texel.z + backLayerOffset);
         vec3 incomingBack = incomingRadiance(bestBackNode, ownSide, ahead ? -bundleDir : bundleDir);
-        imageStore(accum, back, uvec4(foldSample(imageLoad(accum, back).rg, incomingBack, w, pcgHash(h ^ 0x85ebca6bu)), 0u, 0u));
+        uvec2 folded = foldSample(imageLoad(accum, back).rg, incomingBack, w, pcgHash(h ^ 0x85ebca6bu));
+        imageStore(accum, back, uvec4(folded, 0u, 0u));
     }
+#endif
     if (oddDirection && texel.x % halfStride == 0 && texel.y % halfStride == 0) {
         ivec3 half_ = ivec3(texel.xy / halfStride, texel.z);
         imageStore(halfAccum, half_, uvec4(foldSample(imageLoad(halfAccum, half_).rg, incoming, w, pcgHash(h ^ 0x9e3779b9u)), 0u, 0u));
