@@ -46,7 +46,8 @@ void main() {
     uint radianceFront = encodeRgbe(textureLod(radiance, vec3(lightmapUv, float(vPage)), 0.0).rgb, u);
     // A double-sided surface is seen from both sides: one node for both where
     // they look the same, else a second node at the same depth for its back
-    // side's own radiance (update.frag tells the two apart by their sides).
+    // side's own radiance (update.frag tells the two apart by their sides),
+    // unless that is black.
     bool twoSides = (vFlags & TRIANGLE_DOUBLE_SIDED) != 0u;
     uint radianceBack = radianceFront;
 #ifdef BACK_SIDES
@@ -61,8 +62,11 @@ void main() {
     uint frontFlags = twoSides ? NODE_FLAG_MASK : front;
     uint nodeCount = 1u;
     if (radianceBack != radianceFront) {
+        // a black back side needs no node of its own: a side no node is seen
+        // from reads black (the walls of a closed room, seen from outside:
+        // one node each, not two; the texel's own search uses the front's)
         frontFlags = front;
-        nodeCount = 2u;
+        nodeCount = radianceBack == 0u ? 1u : 2u;
     }
     // one site of each atomic, in a loop (llvmpipe runs an atomic's lane loop
     // wherever one is written, whether a lane takes it or not)
