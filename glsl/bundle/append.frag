@@ -68,8 +68,7 @@ void main() {
         frontFlags = front;
         nodeCount = radianceBack == 0u ? 1u : 2u;
     }
-    // one site of each atomic, in a loop (llvmpipe runs an atomic's lane loop
-    // wherever one is written, whether a lane takes it or not)
+    // the front's node, then the back's where there is one
     for (uint k = 0u; k < nodeCount; ++k) {
         uint index = atomicCounterIncrement(nodeCounter);
         if (index >= nodeCapacity) return;  // overflow: the host sees counter > capacity and redraws split
