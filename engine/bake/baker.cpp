@@ -112,8 +112,13 @@ nlohmann::json BakeStats::toJson() const {
     return j;
 }
 
+double defaultHistoryPower(double largestAlbedo) {
+    const double rho = std::min(largestAlbedo, 0.99);
+    return std::clamp(std::round(2.0 * rho / std::pow(1.0 - rho, 1.5)), 1.0, 1024.0);
+}
+
 Status Baker::Impl::buildPrograms() {
-    std::string rounding = options.rounding == Rounding::Nearest ? "#define ROUNDING_NEAREST 1\n" : "";
+    const std::string rounding = roundingDefine();
     struct Spec {
         gl::Program* target;
         std::vector<std::string> files;
@@ -338,8 +343,9 @@ Status Baker::Impl::init(const Scene& scene) {
     if (layout.resolution > maxTex)
         return Status::error("--resolution " + std::to_string(layout.resolution) + " exceeds GL_MAX_TEXTURE_SIZE " +
                              std::to_string(maxTex));
-    for (const BakeTriangle& t : mesh.triangles)
-        if (t.flags & TRIANGLE_DOUBLE_SIDED) backLayerOffset = layout.pageCount;
+    if (std::any_of(mesh.triangles.begin(), mesh.triangles.end(),
+                    [](const BakeTriangle& t) { return (t.flags & TRIANGLE_DOUBLE_SIDED) != 0u; }))
+        backLayerOffset = layout.pageCount;
     if (stateLayers() > maxLayers)
         return Status::error(std::to_string(layout.pageCount) + " light map pages" +
                              (backLayerOffset ? " (twice over: double-sided materials)" : "") +
@@ -416,8 +422,7 @@ Status Baker::Impl::init(const Scene& scene) {
     float rho = 0;
     for (const auto& m : materials) rho = std::max({rho, m.albedo.r, m.albedo.g, m.albedo.b});
     rho = std::min(rho, 0.99f);
-    historyPower = options.historyPower >= 0 ? options.historyPower
-                                             : std::clamp(std::round(2.0 * rho / std::pow(1.0 - rho, 1.5)), 1.0, 1024.0);
+    historyPower = options.historyPower >= 0 ? options.historyPower : defaultHistoryPower(rho);
     refreshEveryRound = std::max(64, int(std::ceil(std::log(1000.0) / (1.0 - double(rho)))));
     stats.historyPower = historyPower;
     directions = makeDirections(options.directions, options.seed);
@@ -517,9 +522,7 @@ Status Baker::Impl::init(const Scene& scene) {
         const BundleScene scene{&mesh, &clusters, vao.id(), vertexBuffer.id(), triangleBuffer.id(), radiance.id(),
                                 pageFbo.id(), res, materialAlphaBuffer.id(), alphaTexelBuffer.id(), backLayerOffset};
         const BundleLimits limits{nodeCapacity, maxTileSize, subpixelBits, options.predictTiles};
-        auto t = BundleTracer::create(
-            scene, limits, (options.rounding == Rounding::Nearest ? "#define ROUNDING_NEAREST 1\n" : "") + backSidesDefine(),
-            &stats);
+        auto t = BundleTracer::create(scene, limits, roundingDefine() + backSidesDefine(), &stats);
         if (!t) return t.status();
         tracer = std::move(t.value());
     }

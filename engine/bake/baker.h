@@ -56,7 +56,7 @@ struct BakeOptions {
     Rounding rounding = Rounding::Stochastic;
     // History ramp: direction k is weighted min(k, directions/2)^power, so early
     // directions (which saw light maps with few bounces) fade out. < 0 = from
-    // the scene's largest albedo: round(2 rho / (1 - rho)^1.5), clamped to [1, 1024].
+    // the scene's largest albedo (defaultHistoryPower).
     float historyPower = -1.0f;
     // Cut each tile until its predicted node count (projected cluster areas /
     // pixel area) fits 80 % of the budget's node buffer, and size the buffer
@@ -151,6 +151,11 @@ struct BakeProgress {
     bool combined = true;
     bool done() const { return directionsDone >= directionsTotal; }
 };
+
+// BakeOptions::historyPower < 0: round(2 rho / (1 - rho)^1.5) in [1, 1024] for
+// the scene's largest albedo rho (capped at 0.99): the more bounces light
+// needs, the faster the early directions fade (docs/design-notes.md).
+double defaultHistoryPower(double largestAlbedo);
 
 // The light maps of a bake: one image per page, L_lm = E/pi (DESIGN.md Units),
 // texel row 0 = v 0 (GL order), padding dilated. `covered` marks texels whose

@@ -68,6 +68,9 @@ struct Baker::Impl {
     // The bundle and update programs handle back sides only when built with it:
     // llvmpipe runs even a uniformly skipped branch's texture fetch (25 % of the bundle pass)
     std::string backSidesDefine() const { return backLayerOffset ? "#define BACK_SIDES 1\n" : ""; }
+    std::string roundingDefine() const {
+        return options.rounding == Rounding::Nearest ? "#define ROUNDING_NEAREST 1\n" : "";
+    }
     gl::Texture accumAsFloat, radianceBits, radianceAsFloat;  // views: rg32f, r32ui, r32f
     gl::Texture resolved;  // the whole light map L_lm, made on first use (the viewer's)
     // the noise estimate (noise.cpp): the odd directions' accumulators at every

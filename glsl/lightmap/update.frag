@@ -104,7 +104,6 @@ uint nearestNode(ivec2 pixel, float start, bool forward, uint seen) {
     return bestNode;
 }
 
-
 #ifndef SUN_PASS
 // L_in from node i seen from side `seen` (a back face is black), or the
 // environment looking along `look` where nothing is there.

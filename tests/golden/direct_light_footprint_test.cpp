@@ -21,6 +21,7 @@
 #include "layout/layout.h"
 #include "reference/reference_baker.h"
 #include "scene/scene.h"
+#include "support/bake_helper.h"
 #include "support/gl_fixture.h"
 #include "support/hand_scenes.h"
 
@@ -38,10 +39,7 @@ TEST(DirectLightFootprint, CornellDirectLightMatchesReferenceInPenumbrae) {
         m.albedo = glm::vec3(0.0f);
         m.albedoTexture = -1;
     }
-    LayoutOptions lo;
-    lo.mode = UvLayout::Asset;
-    lo.resolution = 64;
-    auto layout = computeLayout(scene, lo);
+    auto layout = computeLayout(scene, assetLayout(64));
     ASSERT_TRUE(layout) << layout.error();
 
     BakeOptions bo;

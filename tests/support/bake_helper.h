@@ -214,11 +214,6 @@ inline double furnaceExpectation(double le, double rho, int directions, double h
     return m;
 }
 
-// The baker's default history power for a largest albedo rho (BakeOptions::historyPower < 0).
-inline double defaultHistoryPower(double rho) {
-    rho = std::min(rho, 0.99);
-    return std::clamp(std::round(2.0 * rho / std::pow(1.0 - rho, 1.5)), 1.0, 1024.0);
-}
 
 // --- texels to triangles (CPU) ----------------------------------------------
 
