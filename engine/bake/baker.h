@@ -97,7 +97,7 @@ struct BakeStats {
     double radianceUnit = 1;          // the light-map state holds radiance / this (a power of two; fp16 range)
     int64_t tilesDrawn = 0;
     int64_t overflows = 0;            // tile draws whose node count exceeded the buffer: redrawn (bigger buffer, or split)
-    int64_t fragments = 0;            // nodes appended (kept), over all tiles
+    int64_t fragments = 0;            // nodes appended (kept) for the tiles' own pixels, over all tiles
     int64_t updatedTexels = 0;        // texel samples accumulated
     int64_t peakNodesPerTile = 0;
     int64_t nodeCapacity = 0;

@@ -23,8 +23,10 @@ void setFrameUniforms(GLuint program, const TileFrame& f) {
     glUniform1f(glGetUniformLocation(program, "leafExtent"), float(f.leaf.extent));
     glUniform1i(glGetUniformLocation(program, "leafPixels"), f.leaf.pixels);
     glUniform1f(glGetUniformLocation(program, "pixelSize"), f.pixelSize);
-    glUniform2i(glGetUniformLocation(program, "tileOffset"), f.window.x, f.window.y);
-    glUniform2i(glGetUniformLocation(program, "tileSize"), f.window.width, f.window.height);
+    glUniform2i(glGetUniformLocation(program, "tileOffset"), f.drawn.x, f.drawn.y);
+    glUniform2i(glGetUniformLocation(program, "tileSize"), f.drawn.width, f.drawn.height);
+    glUniform4i(glGetUniformLocation(program, "ownedPixels"), f.window.x - f.drawn.x, f.window.y - f.drawn.y,
+                f.window.x - f.drawn.x + f.window.width, f.window.y - f.drawn.y + f.window.height);
 }
 
 Expected<std::unique_ptr<BundleTracer>> BundleTracer::create(const BundleScene& scene, const BundleLimits& limits,
@@ -40,7 +42,8 @@ Expected<std::unique_ptr<BundleTracer>> BundleTracer::create(const BundleScene& 
     t->chunks_ = MeshChunks::create(int64_t(scene.mesh->triangleCount()),
                                     {{MESH_BINDING_TRIANGLES, scene.triangleBuffer, int64_t(sizeof(BakeTriangle))},
                                      {BINDING_VERTICES, scene.vertexBuffer, 3 * int64_t(sizeof(BakeVertex))}});
-    t->counter_ = gl::Buffer::create("bundle node counter", 4, nullptr, GL_DYNAMIC_STORAGE_BIT);
+    // nodes appended, and those of the tile's own pixels (not its apron's)
+    t->counter_ = gl::Buffer::create("bundle node counters", 8, nullptr, GL_DYNAMIC_STORAGE_BIT);
     t->ensureNodes(limits.predict ? std::min<int64_t>(limits.nodeCapacity, 1 << 16) : limits.nodeCapacity);
     t->ensureHeads(64);
     t->fbo_ = gl::Framebuffer::create("bundle framebuffer (no attachments)");
@@ -116,12 +119,13 @@ void BundleTracer::next(const UpdateFn& update) {
     f.rootSize = float(frame_.size);
     f.leaf = tiling_.leaves[size_t(tile.leaf)];
     f.window = tile.window;
+    f.drawn = drawnWindow(tile.window, f.leaf.pixels);
     f.pixelSize = float(tiling_.pixelSize(tile.leaf));
     // per direction and leaf, never per tile: tiles change with the budget, the bits must not
     const uint32_t leafSeed = pcgHash(seed_ ^ pcgHash(uint32_t(tile.leaf) * 7919u + 17u));
     // buffers sized from the prediction (a quarter of margin), within the budget
     if (limits_.predict) ensureNodes(int64_t(std::ceil(1.25 * tile.predictedNodes)) + 1024);
-    ensureHeads(std::max(tile.window.width, tile.window.height));
+    ensureHeads(std::max(f.drawn.width, f.drawn.height));
 
     // what both passes read (the mesh's SSBOs: per chunk, in drawClusters)
     glBindVertexArray(scene_.vertexArray);
@@ -134,25 +138,25 @@ void BundleTracer::next(const UpdateFn& update) {
     auto tb = Clock::now();
     {
         gl::DebugGroup group("bundle pass");
-        const uint32_t endOfList = END_OF_LIST, zero = 0;
-        glClearTexSubImage(heads_.id(), 0, 0, 0, 0, tile.window.width, tile.window.height, 1, GL_RED_INTEGER,
+        const uint32_t endOfList = END_OF_LIST, zero[2] = {0, 0};
+        glClearTexSubImage(heads_.id(), 0, 0, 0, 0, f.drawn.width, f.drawn.height, 1, GL_RED_INTEGER,
                            GL_UNSIGNED_INT, &endOfList);
-        glNamedBufferSubData(counter_.id(), 0, 4, &zero);
+        glNamedBufferSubData(counter_.id(), 0, 8, zero);
         glUseProgram(append_.id());
         setFrameUniforms(append_.id(), f);
         glUniform1ui(append_.uniform("nodeCapacity"), uint32_t(nodeAllocated_));
         glUniform1ui(append_.uniform("randomSeed"), leafSeed);
         glUniform1i(append_.uniform("backLayerOffset"), scene_.backLayerOffset);
         // the leaf's grid in a power-of-two viewport (glsl/bundle/append.vert) shifted so the
-        // tile lands at (0, 0); the scissor keeps the rest out
+        // drawn window (the tile and its apron) lands at (0, 0); the scissor keeps the rest out
         int viewportPixels = 1;
         while (viewportPixels < f.leaf.pixels) viewportPixels *= 2;
         glUniform1i(append_.uniform("viewportPixels"), viewportPixels);
         glUniform1f(append_.uniform("subpixelSteps"), float(1 << limits_.subpixelBits));
         glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
-        glViewport(-tile.window.x, -tile.window.y, viewportPixels, viewportPixels);
+        glViewport(-f.drawn.x, -f.drawn.y, viewportPixels, viewportPixels);
         glEnable(GL_SCISSOR_TEST);
-        glScissor(0, 0, tile.window.width, tile.window.height);
+        glScissor(0, 0, f.drawn.width, f.drawn.height);
         glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, BINDING_NODE_COUNTER, counter_.id());
         glBindImageTexture(BINDING_HEADS, heads_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
         glBindTextureUnit(BINDING_RADIANCE, scene_.radiance);
@@ -161,8 +165,9 @@ void BundleTracer::next(const UpdateFn& update) {
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                         GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     }
-    uint32_t count = 0;
-    glGetNamedBufferSubData(counter_.id(), 0, 4, &count);
+    uint32_t counts[2] = {0, 0};
+    glGetNamedBufferSubData(counter_.id(), 0, 8, counts);
+    const uint32_t count = counts[0];
     lastCount_ = count;
     ++tiles_;
     if (recordStats_) {
@@ -185,7 +190,7 @@ void BundleTracer::next(const UpdateFn& update) {
         return;
     }
     if (recordStats_) {
-        stats_->fragments += count;
+        stats_->fragments += counts[1];  // each once, whichever tile owns it
         stats_->peakNodesPerTile = std::max<int64_t>(stats_->peakNodesPerTile, count);
         if (count > 0) stats_->predictedOverActual.push_back(tile.predictedNodes / count);
         stats_->tilePixelSizes.push_back(f.pixelSize);

@@ -35,7 +35,8 @@ struct TileFrame {
     glm::vec2 rootOrigin{0.0f};
     float rootSize = 1.0f;
     BundleLeaf leaf;
-    TileWindow window;
+    TileWindow window;  // the pixels the tile owns
+    TileWindow drawn;   // and the pixels it draws: with a one-pixel apron (tiler.h drawnWindow)
     float pixelSize = 1.0f;
 };
 

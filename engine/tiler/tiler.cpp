@@ -239,10 +239,16 @@ std::vector<ClusterView> projectClusters(const BakeMesh& mesh, const std::vector
     return views;
 }
 
+TileWindow drawnWindow(const TileWindow& w, int leafPixels) {
+    const int x0 = std::max(w.x - 1, 0), y0 = std::max(w.y - 1, 0);
+    const int x1 = std::min(w.x + w.width + 1, leafPixels), y1 = std::min(w.y + w.height + 1, leafPixels);
+    return {x0, y0, x1 - x0, y1 - y0};
+}
+
 Tile makeTile(const DirectionTiling& tiling, int leaf, const TileWindow& window, const std::vector<Cluster>& clusters,
               const std::vector<ClusterView>& views, const std::vector<uint32_t>& candidates, bool cull) {
     const BundleLeaf& l = tiling.leaves[size_t(leaf)];
-    const Square s = windowSquare(l, window);
+    const Square s = windowSquare(l, drawnWindow(window, l.pixels));
     Tile t;
     t.leaf = leaf;
     t.window = window;
@@ -288,7 +294,8 @@ DirectionTiling tileBundle(const std::vector<Cluster>& clusters, const std::vect
     // windows: at most maxTilePixels across, split until the prediction fits
     for (size_t l = 0; l < tiling.leaves.size(); ++l) {
         const int w = tiling.leaves[l].pixels;
-        const int step = std::min(w, o.maxTilePixels);
+        // (a leaf wider than a tile: tiles two pixels narrower, so that their aprons fit)
+        const int step = w <= o.maxTilePixels ? w : std::max(1, o.maxTilePixels - 2);
         std::vector<TileWindow> work;
         for (int y = w - (w - 1) % step - 1; y >= 0; y -= step)  // reverse, so popping from the back goes in row order
             for (int x = w - (w - 1) % step - 1; x >= 0; x -= step)

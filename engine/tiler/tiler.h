@@ -99,9 +99,14 @@ struct TileWindow {
     int x = 0, y = 0, width = 0, height = 0;
 };
 
+// The window a tile draws: its own and a one-pixel apron within the leaf, so
+// that the update pass can read the lists of its pixels' neighbours
+// (update.frag) whichever tiles the budget makes.
+TileWindow drawnWindow(const TileWindow& window, int leafPixels);
+
 struct Tile {
     int leaf = 0;
-    TileWindow window;
+    TileWindow window;  // the pixels it owns (drawnWindow: the pixels it draws)
     double predictedNodes = 0;
     std::vector<uint32_t> clusters;  // clusters whose rectangles meet the tile (all, when culling is off)
 };
@@ -114,7 +119,7 @@ struct TilerOptions {
     double pixelsPerTexel = 2;   // bundle pixels per light map texel (the half-texel rule)
     int maxLeafPixels = 1024;    // a leaf's side in pixels (not from the budget: leaves fix the answer)
     int maxDepth = 16;           // quadtree depth limit (root units stay exact in float)
-    int maxTilePixels = 1024;    // a tile's side: the head image
+    int maxTilePixels = 1024;    // a drawn tile's side (apron included): the head image
     double nodeCapacity = 1e9;   // split tiles until predicted <= fill * nodeCapacity
     double fill = 0.8;
     bool cull = true;            // false: every tile draws every cluster (culling on/off tests)
@@ -135,7 +140,7 @@ struct DirectionTiling {
 DirectionTiling tileBundle(const std::vector<Cluster>& clusters, const std::vector<ClusterView>& views,
                            double rootSize, const TilerOptions& options);
 
-// The predicted nodes of `window` of `leaf` and the clusters it meets (from
+// The predicted nodes of `window` of `leaf` (drawn: with its apron) and the clusters it meets (from
 // `candidates`, or all clusters when culling is off): used for new tiles and
 // for the quarters of a tile that overflowed.
 Tile makeTile(const DirectionTiling& tiling, int leaf, const TileWindow& window, const std::vector<Cluster>& clusters,

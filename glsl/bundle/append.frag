@@ -20,7 +20,9 @@ flat in vec3 vUv0XPlane;
 flat in vec3 vUv0YPlane;
 flat in uint vMaterial;
 
-layout(binding = BINDING_NODE_COUNTER) uniform atomic_uint nodeCounter;
+layout(binding = BINDING_NODE_COUNTER, offset = 0) uniform atomic_uint nodeCounter;
+// the nodes of the tile's own pixels (the rest are its apron's, another tile's own)
+layout(binding = BINDING_NODE_COUNTER, offset = 4) uniform atomic_uint ownedCounter;
 layout(binding = BINDING_HEADS, r32ui) uniform coherent uimage2D heads;
 layout(std430, binding = BINDING_NODES) buffer Nodes { Node nodes[]; };
 layout(binding = BINDING_RADIANCE) uniform sampler2DArray radiance;
@@ -30,7 +32,8 @@ uniform uint randomSeed;  // per direction and leaf (not per tile: tiles change 
 uniform int backLayerOffset;  // BACK_SIDES: double-sided triangles' back sides' radiance at layer page + backLayerOffset
 
 void main() {
-    ivec2 pixel = ivec2(gl_FragCoord.xy);  // in the tile (the head image)
+    ivec2 pixel = ivec2(gl_FragCoord.xy);  // in the drawn window (the head image)
+    bool owned = all(greaterThanEqual(pixel, ownedPixels.xy)) && all(lessThan(pixel, ownedPixels.zw));
     ivec2 leafPixel = pixel + tileOffset;
     vec2 centre = vec2(leafPixel) + 0.5;
     // a cut-out's cut-away part is not there: no node, light goes through
@@ -72,6 +75,7 @@ void main() {
     for (uint k = 0u; k < nodeCount; ++k) {
         uint index = atomicCounterIncrement(nodeCounter);
         if (index >= nodeCapacity) return;  // overflow: the host sees counter > capacity and redraws split
+        if (owned) atomicCounterIncrement(ownedCounter);
         nodes[index].radiance = k == 0u ? radianceFront : radianceBack;
         nodes[index].depth = depthBits | (k == 0u ? frontFlags : NODE_FLAG_MASK & ~front);
         nodes[index].next = imageAtomicExchange(heads, pixel, index);

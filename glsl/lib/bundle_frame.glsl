@@ -16,8 +16,9 @@ uniform vec2 leafMin;        // the leaf's lower-left corner, root units
 uniform float leafExtent;    // the leaf's side, root units
 uniform int leafPixels;      // pixels across the leaf
 uniform float pixelSize;     // scene units per pixel of this leaf
-uniform ivec2 tileOffset;    // the tile's first pixel in the leaf's grid
-uniform ivec2 tileSize;      // pixels
+uniform ivec2 tileOffset;    // the drawn window's first pixel in the leaf's grid (the head image's origin)
+uniform ivec2 tileSize;      // the drawn window's pixels: the tile's own and a one-pixel apron within the leaf
+uniform ivec4 ownedPixels;   // the tile's own pixels in the head image: [xy, zw)
 
 vec3 bundleFromWorld(vec3 p) { return vec3(dot(p, bundleU), dot(p, bundleV), dot(p, bundleDir)); }
 

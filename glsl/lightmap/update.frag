@@ -123,7 +123,61 @@ uvec2 foldSample(uvec2 stored, vec3 incoming, float w, uint h) {
     return uvec2(floatToHalf(sum.r, uniform01(h)) | (floatToHalf(sum.g, uniform01(h1)) << 16u),
                  floatToHalf(sum.b, uniform01(h2)) | (floatToHalf(sum.a, uniform01(h3)) << 16u));
 }
+
 #endif
+
+// The texel's own surface at this sample (main): the sample's point, its
+// depth along d, the triangle's plane (normal ng, ng . d = cg), the texel's
+// size, the surface's curvature and the node flag of the side it looks to.
+struct OwnSurface {
+    vec3 position;
+    float depth;
+    vec3 ng;
+    float cg;
+    float texelSize;
+    float curvature;
+    uint side;
+};
+
+const float NO_CROSSING = 3.0e38;
+
+// The depth at which the ray of `pixel`, which passes `offset` (scene units,
+// the point minus the pixel's centre) beside the sample's point, crosses the
+// texel's own surface: a fragment facing the texel's side at the depth where
+// the ray meets the triangle's plane. NO_CROSSING: none. The crossing must lie
+// within one texel (at least two pixels) of the point in 3D: at grazing angles
+// the ray meets the plane far away, past a wall's edge, where a fragment of
+// another surface facing the same way (the floor of the room behind a thin
+// wall) would pass for it. The depth tolerance is tight: a surface facing the
+// same way a millimetre off (a light under a ceiling) must not pass for it.
+float ownCrossing(OwnSurface own, ivec2 pixel, vec2 offset) {
+    float planeDepth = own.depth + dot(vec2(dot(own.ng, bundleU), dot(own.ng, bundleV)), offset) / own.cg;
+    vec3 crossing = own.position - bundleU * offset.x - bundleV * offset.y + bundleDir * (planeDepth - own.depth);
+    // one texel: two bundle pixels where the pixel is half a texel (the
+    // uniform grid's rule), this texel's own size where the leaf's pixel is
+    // finer (adaptive leaves take their pixel from their densest texel)
+    if (distance(crossing, own.position) > max(2.0 * pixelSize, own.texelSize)) return NO_CROSSING;
+    // On a curved surface the crossing lies on this triangle's plane, which the
+    // neighbouring facets leave by about curvature x r^2 / 2 at r from it (the
+    // triangles of a finely tessellated chair are smaller than a bundle pixel:
+    // their own fragments are mostly another facet's); the curvature from the
+    // shading normals' change across the texel (0 on flat charts, where the
+    // tolerance stays tight).
+    float r = distance(crossing, vPosition);
+    float tolerance = 0.05 * pixelSize + depthBias + 1e-5 * abs(planeDepth) +
+                      min(0.5 * own.curvature * r * r / abs(own.cg), 0.5 * own.texelSize);
+    float self = NO_CROSSING, selfDistance = 3.0e38;
+    // `i < nodeCount` rather than `!= END_OF_LIST`: ends on any stray index too
+    for (uint i = imageLoad(heads, pixel).r; i < nodeCount; i = nodes[i].next) {
+        float z = uintBitsToFloat(nodes[i].depth & ~NODE_FLAG_MASK);  // the depth without its side flags
+        float dz = abs(z - planeDepth);
+        if (dz <= tolerance && (nodes[i].depth & own.side) != 0u && dz < selfDistance) {
+            selfDistance = dz;
+            self = z;
+        }
+    }
+    return self;
+}
 
 void main() {
     // the triangle's own plane, from screen derivatives (before any return:
@@ -173,7 +227,7 @@ void main() {
     if (!leafOwns(q)) return;  // another leaf's
     vec2 g = gridFromRoot(q);
     ivec2 pixel = min(ivec2(floor(g)), ivec2(leafPixels - 1)) - tileOffset;
-    if (any(lessThan(pixel, ivec2(0))) || any(greaterThanEqual(pixel, tileSize))) return;  // another tile's
+    if (any(lessThan(pixel, ownedPixels.xy)) || any(greaterThanEqual(pixel, ownedPixels.zw))) return;  // another tile's
 
     // The side the texel looks to is its triangle's (ng, the side the bundle
     // pass gives the triangle's own fragments); its shading normal n weighs the
@@ -184,54 +238,37 @@ void main() {
     if (cosine <= 0.0) return;
     uint ownSide = ahead ? NODE_VISIBLE_FROM_AHEAD : NODE_VISIBLE_FROM_BEHIND;
     uint seenSide = ahead ? NODE_VISIBLE_FROM_BEHIND : NODE_VISIBLE_FROM_AHEAD;
-    // The ray through the pixel centre passes r (up to half a pixel diagonal)
-    // beside the texel; the texel's own surface crosses it within r * tan(theta)
-    // in depth. Find that crossing (a fragment facing the texel's side): the
-    // ray then starts exactly on the surface. The crossing must also lie within
-    // 2 pixels (one texel) of the sample's point in 3D: at grazing angles the ray
-    // meets the surface's plane far away, past a wall's edge, where a fragment
-    // of another surface facing the same way (the floor of the room behind a
-    // thin wall) would pass for it. No crossing: the ray runs beside the
-    // surface (past an edge, outside a closed mesh) and would see what the
-    // texel cannot, so the sample is skipped (W unchanged), as Unity's
-    // backface validity does.
-    vec2 offset = (g - floor(g) - 0.5) * pixelSize;  // texel minus pixel centre, scene units
-    // one texel: two bundle pixels where the pixel is half a texel (the
-    // uniform grid's rule), this texel's own size where the leaf's pixel is
-    // finer (adaptive leaves take their pixel from their densest texel)
-    float reach = max(2.0 * pixelSize, texelSize);
-    // where the ray meets the texel's own (triangle) plane, in depth
+    // The ray through the pixel centre passes beside the sample's point; find
+    // where it crosses the texel's own surface (ownCrossing), so that it starts
+    // exactly on the surface. Near an edge of the surface (a block's side
+    // meeting the floor) the crossing can fall past it, off the surface: the
+    // ray would run beside the surface and see what the texel cannot. The
+    // sample then takes a neighbouring pixel whose ray does cross the surface
+    // (within one pixel of the point): skipping it instead (as Unity's backface
+    // validity does) drops the directions toward the edge and so weighs the
+    // rest too much (rel_rmse against the reference, 1024 directions: two rooms
+    // 1.09 -> 1.04 %, Cornell box 2.38 -> 2.26 %; the update pass +5 % on the
+    // city). No crossing in any: skipped (W unchanged).
     float cg = dot(ng, bundleDir);
     if (abs(cg) < 1e-4) return;
-    float planeDepth = b.z + dot(vec2(dot(ng, bundleU), dot(ng, bundleV)), offset) / cg;
-    // the own-surface fragment: facing the texel's side, at that depth (a
-    // surface facing the same way a millimetre off, such as a light under a
-    // ceiling, must not pass for it)
-    float tolerance = 0.05 * pixelSize + depthBias + 1e-5 * abs(planeDepth);
-    float self = 0.0;
-    float selfDistance = 3.0e38;
-    vec3 crossing = position - bundleU * offset.x - bundleV * offset.y + bundleDir * (planeDepth - b.z);
-    if (distance(crossing, position) > reach) return;  // beyond one texel
-    // On a curved surface the crossing lies on this triangle's plane, which the
-    // neighbouring facets leave by about curvature x r^2 / 2 at r from it (the
-    // triangles of a finely tessellated chair are smaller than a bundle pixel:
-    // their own fragments are mostly another facet's); the curvature from the
-    // shading normals' change across the texel (0 on flat charts, where the
-    // tolerance stays tight).
-    float curvature = max(length(normalDx) / max(length(positionDx), 1e-30),
-                          length(normalDy) / max(length(positionDy), 1e-30));
-    float r = distance(crossing, vPosition);
-    tolerance += min(0.5 * curvature * r * r / abs(cg), 0.5 * texelSize);
-    // `i < nodeCount` rather than `!= END_OF_LIST`: ends on any stray index too
-    for (uint i = imageLoad(heads, pixel).r; i < nodeCount; i = nodes[i].next) {
-        float z = uintBitsToFloat(nodes[i].depth & ~NODE_FLAG_MASK);  // the depth without its side flags
-        float dz = abs(z - planeDepth);
-        if (dz <= tolerance && (nodes[i].depth & ownSide) != 0u && dz < selfDistance) {
-            selfDistance = dz;
-            self = z;
+    vec2 offset = (g - floor(g) - 0.5) * pixelSize;  // texel minus pixel centre, scene units
+    OwnSurface own = OwnSurface(position, b.z, ng, cg, texelSize,
+                                max(length(normalDx) / max(length(positionDx), 1e-30),
+                                    length(normalDy) / max(length(positionDy), 1e-30)),
+                                ownSide);
+    float self = ownCrossing(own, pixel, offset);
+    if (self == NO_CROSSING) {
+        // the three on the point's side of the pixel's centre (toward sign(offset)): their rays pass nearer it
+        const ivec2 order[3] = ivec2[3](ivec2(1, 0), ivec2(0, 1), ivec2(1, 1));
+        ivec2 toward = ivec2(offset.x < 0.0 ? -1 : 1, offset.y < 0.0 ? -1 : 1);
+        for (int k = 0; k < 3 && self == NO_CROSSING; ++k) {
+            ivec2 step = order[k] * toward, neighbour = pixel + step;
+            if (any(lessThan(neighbour, ivec2(0))) || any(greaterThanEqual(neighbour, tileSize))) continue;
+            self = ownCrossing(own, neighbour, offset - vec2(step) * pixelSize);
+            if (self != NO_CROSSING) pixel = neighbour;
         }
+        if (self == NO_CROSSING) return;
     }
-    if (selfDistance > tolerance) return;
     float start = self + (ahead ? depthBias : -depthBias);
 
     uint bestNode = nearestNode(pixel, start, ahead, seenSide);

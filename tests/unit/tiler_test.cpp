@@ -181,8 +181,10 @@ TEST(Tiler, PredictionMatchesTheRasterAndTilesFitTheBudget) {
     double predicted = 0, exact = 0;
     for (const Tile& t : tiling.tiles) {
         EXPECT_LE(t.predictedNodes, o.fill * o.nodeCapacity);
-        EXPECT_LE(std::max(t.window.width, t.window.height), o.maxTilePixels);
-        const double n = exactFragments(mesh, frame, tiling.leaves[size_t(t.leaf)], t.window);
+        const BundleLeaf& leaf = tiling.leaves[size_t(t.leaf)];
+        const TileWindow drawn = drawnWindow(t.window, leaf.pixels);  // the tile and its apron: the head image
+        EXPECT_LE(std::max(drawn.width, drawn.height), o.maxTilePixels);
+        const double n = exactFragments(mesh, frame, leaf, drawn);
         predicted += t.predictedNodes;
         exact += n;
         if (n > 200) EXPECT_NEAR(t.predictedNodes / n, 1.0, 0.35) << "tile " << t.window.x << "," << t.window.y;
