@@ -217,6 +217,20 @@ TEST(Tiler, LeavesDoNotDependOnTheBudgetButTilesDo) {
     }
 }
 
+// A tile draws its own pixels and a one-pixel apron, clipped to its leaf:
+// every own pixel's neighbours are in its lists (update.frag), and a tile
+// that is the whole leaf draws nothing more.
+TEST(Tiler, DrawnWindowIsTheTileAndAOnePixelApronWithinTheLeaf) {
+    const auto same = [](const TileWindow& a, const TileWindow& b) {
+        return a.x == b.x && a.y == b.y && a.width == b.width && a.height == b.height;
+    };
+    EXPECT_TRUE(same(drawnWindow({0, 0, 8, 8}, 8), {0, 0, 8, 8}));
+    EXPECT_TRUE(same(drawnWindow({0, 0, 4, 4}, 8), {0, 0, 5, 5}));
+    EXPECT_TRUE(same(drawnWindow({2, 3, 4, 4}, 8), {1, 2, 6, 6}));
+    EXPECT_TRUE(same(drawnWindow({4, 4, 4, 4}, 8), {3, 3, 5, 5}));
+    EXPECT_TRUE(same(drawnWindow({7, 0, 1, 1}, 8), {6, 0, 2, 2}));
+}
+
 TEST(Tiler, CullingKeepsOnlyClustersThatMeetTheTile) {
     BakeMesh mesh;
     addGrid(mesh, -50, -50, 0, 100, 32, 0);
