@@ -5,8 +5,9 @@
 // leafExtent]^2 in root units, and a tile is an integer window of that grid.
 // Every tile computes a point's root coordinates with the same float
 // operations and leaf bounds are exact in float (powers of 1/2), so a point
-// belongs to exactly one leaf and, within it, one tile: no ray is drawn or
-// read by two tiles, or by none.
+// belongs to exactly one leaf and, within it, one tile: no texel's sample is
+// taken by two tiles, or by none. A tile also draws a one-pixel apron of its
+// neighbours' pixels (within the leaf), whose lists its samples may read.
 uniform vec3 bundleDir;
 uniform vec3 bundleU;
 uniform vec3 bundleV;
