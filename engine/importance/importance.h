@@ -38,6 +38,7 @@
 
 #include <glm/glm.hpp>
 
+#include "glsl/shared/importance_layout.h"
 #include "layout/bake_mesh.h"
 
 namespace bb {
@@ -69,11 +70,11 @@ struct Importance {
 
 // Stand-in for Eq. (1)'s +infinity when a triangle has light map area but no
 // world area (A_o = 0 in float): Eq. (4) then takes I_max(t).
-inline constexpr float MAX_AREA_RATIO = 3.402823466e38f;  // FLT_MAX
+inline constexpr float MAX_AREA_RATIO = float(IMPORTANCE_MAX_AREA_RATIO);  // FLT_MAX
 
 // I_max(t) of a triangle covering a texel centre with no Eq. (3) estimate
 // (texelDensity 0): Eq. (4) takes A_l/A_o where that is below MAX_AREA_RATIO, else 0.
-inline constexpr float NO_DENSITY_ESTIMATE = 3.402823466e38f;  // FLT_MAX: wins every maximum
+inline constexpr float NO_DENSITY_ESTIMATE = float(IMPORTANCE_NO_DENSITY_ESTIMATE);  // FLT_MAX: wins every maximum
 // Eq. (4) with that convention (clamp.comp mirrors it).
 inline float triangleImportance(float areaRatio, float maxDensity) {
     if (maxDensity == NO_DENSITY_ESTIMATE) return areaRatio < MAX_AREA_RATIO ? areaRatio : 0.0f;

@@ -26,7 +26,6 @@ namespace {
 static_assert(sizeof(BakeVertex) == 48);
 static_assert(offsetof(BakeVertex, position) == 0);
 static_assert(offsetof(BakeVertex, lightmapUv) == 40);
-static_assert(float(IMPORTANCE_MAX_AREA_RATIO) == MAX_AREA_RATIO);
 
 }  // namespace
 

@@ -123,7 +123,6 @@ uvec2 foldSample(uvec2 stored, vec3 incoming, float w, uint h) {
     return uvec2(floatToHalf(sum.r, uniform01(h)) | (floatToHalf(sum.g, uniform01(h1)) << 16u),
                  floatToHalf(sum.b, uniform01(h2)) | (floatToHalf(sum.a, uniform01(h3)) << 16u));
 }
-
 #endif
 
 // The texel's own surface at this sample (main): the sample's point, its

@@ -24,9 +24,9 @@
 #define IMPORTANCE_OUT_TRIANGLE 1
 // Compute work group size of the Eq. (4) pass
 #define IMPORTANCE_GROUP_SIZE 64
-// Eq. (1) when A_o = 0 < A_l (FLT_MAX; engine/importance/importance.h MAX_AREA_RATIO)
+// Eq. (1) when A_o = 0 < A_l (FLT_MAX; engine/importance/importance.h MAX_AREA_RATIO is this)
 #define IMPORTANCE_MAX_AREA_RATIO 3.402823466e38
-// I_max(t) where a texel centre t covers has no Eq. (3) estimate (engine/importance/importance.h NO_DENSITY_ESTIMATE)
+// I_max(t) where a texel centre t covers has no Eq. (3) estimate (importance.h NO_DENSITY_ESTIMATE is this)
 #define IMPORTANCE_NO_DENSITY_ESTIMATE 3.402823466e38
 
 #endif

@@ -214,7 +214,6 @@ inline double furnaceExpectation(double le, double rho, int directions, double h
     return m;
 }
 
-
 // --- texels to triangles (CPU) ----------------------------------------------
 
 // Which triangle of the bake mesh covers each texel centre of a page
