@@ -184,20 +184,19 @@ void Baker::Impl::bakeEmitters() {
 
     DistanceCube cube(shadowCubeSize(*this), triangleBuffer.id(), int64_t(mesh.triangles.size()));
     const float nearPlane = 1e-4f * sphereRadius, farPlane = 4.0f * sphereRadius;
-    // one triangle's ratio sums at a time (direct/emitter.frag), for this pass
-    // only: 8 bytes a texel while the bundle pass's buffers are still small,
+    // one triangle's sums at a time (direct/emitter.frag), for this pass
+    // only: 16 bytes a texel while the bundle pass's buffers are still small,
     // within the budget's share for them
     const int res = layout.resolution;
-    gl::Texture sums = gl::Texture::create2DArray("emitter ratio sums", GL_RG32F, res, res, layout.pageCount);
+    gl::Texture sums = gl::Texture::create2DArray("emitter sums", GL_RGBA32F, res, res, layout.pageCount);
     const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-    glClearTexImage(sums.id(), 0, GL_RG, GL_FLOAT, zero);
-    glBindImageTexture(BINDING_EMITTER_SUMS, sums.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32F);
+    glClearTexImage(sums.id(), 0, GL_RGBA, GL_FLOAT, zero);
+    glBindImageTexture(BINDING_EMITTER_SUMS, sums.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
 
     for (const Emitter& e : emitters) {
         const BakeVertex* v = &mesh.vertices[e.triangle * 3];
         glm::vec3 a(v[0].position), b(v[1].position), c(v[2].position);
         glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
-        const float area = 0.5f * glm::length(glm::cross(b - a, c - a));
         bool doubleSided = mesh.triangles[e.triangle].flags & TRIANGLE_DOUBLE_SIDED;
         for (int i = 0; i < e.samples; ++i) {
             // stratified point on the triangle: R2 sequence (Roberts 2018), folded
@@ -216,7 +215,6 @@ void Baker::Impl::bakeEmitters() {
             glUniform3fv(emitterProgram.uniform("emitterB"), 1, &b.x);
             glUniform3fv(emitterProgram.uniform("emitterC"), 1, &c.x);
             glUniform3fv(emitterProgram.uniform("emitterNormal"), 1, &n.x);
-            glUniform1f(emitterProgram.uniform("emitterArea"), area);
             glUniform1i(emitterProgram.uniform("emitterDoubleSided"), doubleSided);
             glUniform3fv(emitterProgram.uniform("samplePoint"), 1, &point.x);
             glUniform1ui(emitterProgram.uniform("footprintSample"), uint32_t(stats.emitterSampleCount));
@@ -226,6 +224,7 @@ void Baker::Impl::bakeEmitters() {
         glUseProgram(emitterFoldProgram.id());
         const glm::vec3 radiance = e.radiance / radianceUnit;
         glUniform3fv(emitterFoldProgram.uniform("emitterRadiance"), 1, &radiance.x);
+        glUniform1f(emitterFoldProgram.uniform("sampleCount"), float(e.samples));
         bindDirectSums(*this);
         dispatchPages(emitterFoldProgram.id());
     }

@@ -1,17 +1,22 @@
 #version 450
 // Direct light from an emissive triangle, one of its visibility samples, at
 // the sample's point x of the texel's footprint (lib/texel_footprint.glsl:
-// over the samples, the texel's mean). The triangle's light is
-//   Le * F(x) * sum(r V) / sum(r),   r = w / mean(w),   w = cos_x cos_e / d^2
-// over its samples (direct/emitter_fold.comp divides once they are all in),
-// with F the exact polygon form factor (no 1/d^2 noise near the emitter),
-// mean(w) = pi F / A over the triangle (area A) and V the sample's visibility
-// from its distance cube map: a ratio estimate, exact where the triangle is
-// wholly seen and where it is wholly hidden (a sealed room stays 0), that
-// weighs each sample by what it brings. F times the fraction of samples seen
-// (as before) weighs every point of the emitter alike, but the part a
-// blocker hides is mostly the farther, more grazing one: penumbrae read
-// 20-50 % dark on the Cornell box (issue 11).
+// over the samples, the texel's mean). Over the triangle's N samples the
+// texel's light is
+//   Le * (sum F(x) / N) * sum(w V) / sum(w),   w = cos_x cos_e / d^2
+// (direct/emitter_fold.comp divides once they are all in): the footprint's
+// mean of the exact polygon form factor F (no 1/d^2 noise near the emitter)
+// times the visible share of the light, each sample weighted by what it
+// brings, V its visibility from its distance cube map. The share is a ratio
+// estimate, exact where the triangle is wholly seen and where it is wholly
+// hidden (a sealed room stays 0). F times the fraction of samples seen
+// weighs every point of the emitter alike, but the part a blocker hides is
+// mostly the farther, more grazing one: penumbrae read 20-50 % dark on the
+// Cornell box (issue 11). Keeping the mean of F apart from the share matters
+// where F changes across the footprint: sum(F r V) / sum(r), r = w / mean(w)
+// at each sample's own x, leaned toward the points with the largest r, those
+// that see the light most obliquely, and read the ceiling texels along a
+// panel light's outline 50-80 % dark (the shared Cornell box).
 #include "shared/bundle_layout.h"
 #include "shared/mesh_layout.h"
 #include "lib/rounding.glsl"
@@ -24,16 +29,13 @@ in vec3 vNormal;
 in vec3 vBary;
 flat in uint vFlags;
 
-layout(binding = BINDING_EMITTER_SUMS, rg32f) uniform coherent image2DArray sums;  // (sum f r V, sum r)
+layout(binding = BINDING_EMITTER_SUMS, rgba32f) uniform coherent image2DArray sums;  // (sum F, sum w V, sum w, -)
 uniform vec3 emitterA, emitterB, emitterC;  // world vertices
 uniform vec3 emitterNormal;
-uniform float emitterArea;
 uniform bool emitterDoubleSided;
 uniform vec3 samplePoint;
 uniform int page;
 uniform uint footprintSample;              // this emitter sample's index over all emitters
-
-const float PI = 3.14159265358979;
 
 void main() {
     vec3 positionDx = dFdx(vPosition), positionDy = dFdy(vPosition);
@@ -54,11 +56,14 @@ void main() {
     if (emitterDoubleSided ? abs(facing) <= planeEpsilon : facing <= planeEpsilon) return;
     float f = polygonFormFactor(x, n, emitterA, emitterB, emitterC);
     if (f <= 0.0) return;
-    // the sample's weight relative to the triangle's mean; below x's horizon 0
+    // the sample's weight; below x's horizon 0
     float r2 = dot(toX, toX);
     float cosX = -dot(n, toX), cosE = abs(dot(emitterNormal, toX));
-    if (cosX <= 0.0) return;
-    float r = cosX * cosE / (r2 * r2) * emitterArea / (PI * f);
+    if (cosX <= 0.0) {
+        imageStore(sums, texel, imageLoad(sums, texel) + vec4(f, 0.0, 0.0, 0.0));
+        return;
+    }
+    float w = cosX * cosE / (r2 * r2);
     float seen = occludedFromLight(x, cross(positionDx, positionDy), samplePoint) ? 0.0 : 1.0;
-    imageStore(sums, texel, imageLoad(sums, texel) + vec4(f * r * seen, r, 0.0, 0.0));
+    imageStore(sums, texel, imageLoad(sums, texel) + vec4(f, w * seen, w, 0.0));
 }

@@ -32,7 +32,7 @@ struct Node {
 #define BINDING_SCRATCH_RG 3     // image unit: rg32f view of the accumulators: direct light sums (r, g) while it is baked
 #define BINDING_SCRATCH_B 4      // image unit: r32f view of the radiance map: direct light sums (b) while it is baked
 #define BINDING_RADIANCE_BITS 5  // image unit: r32ui view of the radiance map (RGB9E5 bits), written by the outgoing pass
-#define BINDING_EMITTER_SUMS 5   // image unit: rg32f an emitter triangle's ratio sums while it is baked (direct/emitter.frag)
+#define BINDING_EMITTER_SUMS 5   // image unit: rgba32f an emitter triangle's sums while it is baked (direct/emitter.frag)
 #define BINDING_DILATION 6       // image unit: r8ui per texel: DILATION_SELF, the covered texel it copies, or DILATION_NONE
 #define BINDING_TARGET 7         // image unit: rgba32f light map L_lm (the resolve's output)
 #define BINDING_HALF_ACCUM 3     // image unit: rg32ui odd directions' accumulators at every halfStride-th texel
