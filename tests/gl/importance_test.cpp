@@ -37,6 +37,7 @@
 #include "support/bake_helper.h"
 #include "support/gl_fixture.h"
 #include "support/importance_meshes.h"
+#include "support/scratch_dirs.h"
 
 namespace bb {
 namespace {
@@ -510,7 +511,8 @@ CliRun runCli(const std::string& args) {
     const std::string dir = ::testing::TempDir();
     // per process: ctest -j runs the CLI tests side by side
     const std::string tag = std::to_string(::getpid());
-    const std::string out = dir + "/imp_cli_out_" + tag + ".txt", err = dir + "/imp_cli_err_" + tag + ".txt";
+    const std::string out = test::removeAtExit(dir + "/imp_cli_out_" + tag + ".txt"),
+                      err = test::removeAtExit(dir + "/imp_cli_err_" + tag + ".txt");
     CliRun r;
     const std::string backend = test::defaultTestBackend() == Backend::Egl ? "egl" : "osmesa";
     const int s = std::system((std::string(BUNDLEBAKE_CLI) + " importance " + args + " --backend " + backend + " >" +
@@ -555,7 +557,7 @@ TEST(ImportanceCli, WritesMapsJsonAndPrintsTheDistribution) {
 TEST(ImportanceCli, MappedTexelsAreTheLightMapsCoveredTexels) {
     BB_REQUIRE_GL();
     namespace fs = std::filesystem;
-    const std::string dir = ::testing::TempDir() + "/importance_rows_" + std::to_string(::getpid());
+    const std::string dir = test::removeAtExit(::testing::TempDir() + "/importance_rows_" + std::to_string(::getpid()));
     fs::remove_all(dir);
     CliRun r = runCli(test::sourcePath("assets/cornell_box/cornell_box.gltf") + " --uv-layout asset --resolution 64 -o " + dir);
     ASSERT_EQ(r.status, 0) << r.err;

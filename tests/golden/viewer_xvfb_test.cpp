@@ -16,6 +16,7 @@
 
 #include "render/scene_renderer.h"
 #include "support/gl_fixture.h"
+#include "support/scratch_dirs.h"
 
 namespace bb::test {
 namespace {
@@ -26,7 +27,7 @@ TEST(ViewerXvfb, ScriptedScreenshotShowsTheLitScene) {
 #else
     if (std::system("command -v xvfb-run > /dev/null 2>&1") != 0)
         GTEST_SKIP() << "xvfb-run is not installed (Debian: apt-get install xvfb)";
-    const std::string dir = testing::TempDir() + "/bundlebake_viewer_xvfb_" + std::to_string(::getpid());
+    const std::string dir = removeAtExit(testing::TempDir() + "/bundlebake_viewer_xvfb_" + std::to_string(::getpid()));
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     const std::string shot = dir + "/shot.png", log = dir + "/viewer.log";

@@ -26,6 +26,7 @@
 #include "layout/layout.h"
 #include "scene/scene.h"
 #include "support/gl_fixture.h"
+#include "scratch_dirs.h"
 
 namespace bb::test {
 
@@ -68,7 +69,7 @@ inline SceneBake makeBake(const std::string& assetRelative, const LayoutOptions&
 // Generates a tiny city (scripts/generate_city.py, seeded by `flags`) into a
 // per-process temp dir; returns its absolute path, or "" if the script failed.
 inline std::string generateTinyCity(const std::string& name, const std::string& flags) {
-    const std::string dir = ::testing::TempDir() + "/cities_" + std::to_string(::getpid());
+    const std::string dir = removeAtExit(::testing::TempDir() + "/cities_" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);
     const std::string path = dir + "/" + name + ".gltf";
     const std::string cmd = "python3 " + sourcePath("scripts/generate_city.py") + " --preset tiny " + flags + " -o " +

@@ -18,6 +18,8 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include "scratch_dirs.h"
+
 namespace bb::test {
 
 // `sourceFile` is the asset's .gltf path. Returns the written file's path, or
@@ -37,7 +39,7 @@ inline std::string writeTranslatedGltf(const std::string& sourceFile, const glm:
         *error = source.string() + " is not a glTF with scenes and nodes";
         return "";
     }
-    const fs::path dir = fs::temp_directory_path() / ("bundlebake_" + tag + "_" + std::to_string(getpid()));
+    const fs::path dir = removeAtExit(fs::temp_directory_path() / ("bundlebake_" + tag + "_" + std::to_string(getpid())));
     std::error_code ec;
     fs::create_directories(dir, ec);
     // external buffers: copied next to the new file (relative URIs keep working)

@@ -12,6 +12,7 @@
 #include "export/gltf_export.h"
 #include "layout/layout.h"
 #include "scene/scene.h"
+#include "../support/scratch_dirs.h"
 
 namespace bb {
 namespace {
@@ -86,7 +87,8 @@ nlohmann::json glbJson(const std::string& path) {
 }
 
 TEST(GltfExport, InstancesInTwoRectanglesShareGeometryAndReadBack) {
-    const auto dir = std::filesystem::path(::testing::TempDir()) / ("export_unit_" + std::to_string(::getpid()));
+    const std::filesystem::path dir =
+        test::removeAtExit(::testing::TempDir() + "/export_unit_" + std::to_string(::getpid()));
     const std::string source = writeTwoQuadScene(dir);
     auto scene = loadScene(source);
     ASSERT_TRUE(scene) << scene.error();
