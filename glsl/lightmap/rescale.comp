@@ -11,12 +11,20 @@ uniform uint randomSeed;
 uniform int pageCount;
 uniform ivec2 pageSize;
 
+const float SMALLEST_NORMAL_HALF = 6.103515625e-5;  // 2^-14
+
 void main() {
     ivec3 t = ivec3(gl_GlobalInvocationID.xy, gl_GlobalInvocationID.z);
     if (t.x >= pageSize.x || t.y >= pageSize.y || t.z >= pageCount) return;
     uvec2 p = imageLoad(accum, t).rg;
     if (p == uvec2(0u)) return;
-    float w = factor * halfToFloat(p.y >> 16u);
+    // a texel that was sampled stays sampled: its weight never rounds to 0
+    // (meta.frag and resolve.comp read a texel whose W is 0 as never sampled,
+    // black). The early rounds of a steep ramp scale by e^-97 and less: W
+    // underflowed, and a texel that then missed a round (no own surface in
+    // its pixel) lost its light for a bounce, which held the rho 0.99 furnace
+    // at 46 instead of 73 after 256 directions.
+    float w = max(factor * halfToFloat(p.y >> 16u), SMALLEST_NORMAL_HALF);
     uint h = pcgHash(randomSeed ^ pcgHash(uint(t.x) | (uint(t.y) << 16u)) ^ pcgHash(uint(t.z) + 104729u));
     imageStore(accum, t, uvec4(p.x, (p.y & 0xFFFFu) | (floatToHalf(w, uniform01(h)) << 16u), 0u, 0u));
 }

@@ -86,10 +86,13 @@ TEST(FurnaceBake, Rho09Gives10Everywhere) {
 }
 
 // rho 0.99 (answer 100) needs ~700 bounces: the refresh follows every
-// direction until rho^b < 1e-3 (baker.cpp). 4096 directions: mean 98.3
-// (-1.7 %; 71.3 with the schedule before); texels within 4 %. Issue 11: within 2 %.
+// direction until rho^b < 1e-3 (baker.cpp). Issue 11: within 2 % at 1024
+// directions; seed 1 reads 98.71 (-1.3 %; the ramp's own expectation is
+// 99.34), texels 97.94..99.00. It read 97.61 while the history ramp's rescale
+// could round a sampled texel's weight to 0 (rescale.comp): a texel that
+// then missed a round was read as black for a bounce.
 TEST(FurnaceBake, Rho099Gives100Everywhere) {
-    runFurnace({"assets/furnace/furnace_rho09.gltf", 0.99, 4096, 0.04, BakeOptions::Tiling::Adaptive, 0.02, 0.99f});
+    runFurnace({"assets/furnace/furnace_rho09.gltf", 0.99, 1024, 0.04, BakeOptions::Tiling::Adaptive, 0.02, 0.99f});
 }
 
 // The Hermes et al. baseline (--tiling uniform) gives the same answers.
