@@ -1,7 +1,8 @@
 #version 430
 // Bundle pass: append one node per fragment to its pixel's linked list.
 // Outgoing radiance comes from the previous iteration: Lo = Le + albedo * L_lm,
-// written per texel into the RGB9E5 `radiance` (lightmap/meta.frag).
+// written per texel into the RGB9E5 `radiance` (lightmap/meta.frag), read
+// at the fragment's texel (GL_NEAREST: its footprint's mean, engine/bake/baker.cpp).
 #include "shared/bundle_layout.h"
 #include "shared/mesh_layout.h"
 #include "lib/rounding.glsl"
