@@ -153,7 +153,8 @@ void Baker::Impl::combineShares(int round) {
                 uint16_t h[4];
                 for (uint32_t c = 0; c < 3; ++c) h[c] = floatToHalf(mean[int(c)], options.rounding, rnd(texel, c));
                 // a sampled texel stays sampled (W > 0), as rescale.comp keeps it
-                h[3] = floatToHalf(w > 0.0f ? std::max(w, 6.103515625e-5f) : 0.0f, options.rounding, rnd(texel, 3));
+                const float kept = w > 0.0f ? std::max(w, float(SAMPLED_MIN_WEIGHT)) : 0.0f;
+                h[3] = floatToHalf(kept, options.rounding, rnd(texel, 3));
                 raw[covered[i]] = glm::uvec2(h[0] | uint32_t(h[1]) << 16, h[2] | uint32_t(h[3]) << 16);
             }
             gl::writeTexture(texture.id(), 0, 0, p, width, width, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());

@@ -2,16 +2,15 @@
 // Multiplies every accumulator's weight W by `factor`, with the same
 // rounding as the update pass. Keeps fp16 weights in range when the direction
 // weights of the history ramp grow; the stored mean (rgb) is unchanged.
+#include "shared/bundle_layout.h"
 #include "lib/rounding.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(binding = 1, rg32ui) uniform uimage2DArray accum;
+layout(binding = BINDING_ACCUM, rg32ui) uniform uimage2DArray accum;
 uniform float factor;
 uniform uint randomSeed;
 uniform int pageCount;
 uniform ivec2 pageSize;
-
-const float SMALLEST_NORMAL_HALF = 6.103515625e-5;  // 2^-14
 
 void main() {
     ivec3 t = ivec3(gl_GlobalInvocationID.xy, gl_GlobalInvocationID.z);
@@ -24,7 +23,7 @@ void main() {
     // underflowed, and a texel that then missed a round (no own surface in
     // its pixel) lost its light for a bounce, which held the rho 0.99 furnace
     // at 46 instead of 73 after 256 directions.
-    float w = max(factor * halfToFloat(p.y >> 16u), SMALLEST_NORMAL_HALF);
+    float w = max(factor * halfToFloat(p.y >> 16u), SAMPLED_MIN_WEIGHT);
     uint h = pcgHash(randomSeed ^ pcgHash(uint(t.x) | (uint(t.y) << 16u)) ^ pcgHash(uint(t.z) + 104729u));
     imageStore(accum, t, uvec4(p.x, (p.y & 0xFFFFu) | (floatToHalf(w, uniform01(h)) << 16u), 0u, 0u));
 }

@@ -22,6 +22,11 @@ struct Node {
 #define NODE_VISIBLE_FROM_AHEAD 2u    // seen by texels looking along -d (surface front faces +d)
 #define NODE_FLAG_MASK 3u
 
+// The least weight W an accumulator that has been sampled keeps (the smallest
+// normal fp16, 2^-14): W = 0 means "never sampled", which the outgoing pass
+// and the resolve read as black (lightmap/rescale.comp, the MPI combine).
+#define SAMPLED_MIN_WEIGHT 6.103515625e-5
+
 // Bindings
 #define BINDING_NODES 0          // SSBO: Node nodes[]
 #define BINDING_NODE_COUNTER 0   // atomic counter: nodes appended
