@@ -18,6 +18,7 @@
 #include "reference/reference_baker.h"
 #include "scene/scene.h"
 #include "support/gl_fixture.h"
+#include "support/hand_scenes.h"
 
 namespace bb {
 namespace {
@@ -165,6 +166,49 @@ TEST(ReferenceVsBake, OpenBoxProbes) {
         EXPECT_LT(std::fabs(cpu - exact) / exact, 0.04) << probe["name"] << ": reference " << cpu << " vs " << exact;
         EXPECT_LT(std::fabs(gpu - exact) / exact, 0.05) << probe["name"] << ": bundlebake " << gpu << " vs " << exact;
     }
+}
+
+}  // namespace
+}  // namespace bb
+
+namespace bb {
+namespace {
+
+// A chart whose borders run through texel centres: GL's rasterizer and the
+// reference settle the ties alike (left and bottom edges count, page space
+// being GL's window space), so both cover the same texels. The reference
+// counted top edges: a 10 x 6 texel quad was covered one row apart.
+TEST(ReferenceVsBake, TexelCentresOnChartBordersAreCoveredAlike) {
+    BB_REQUIRE_GL();
+    Scene scene;
+    const int grey = test::addMaterial(scene, glm::vec3(0.5f));
+    test::addQuad(scene, glm::vec3(0.0f), glm::vec3(5.0f, 0.0f, 0.0f), glm::vec3(0.0f, 3.0f, 0.0f), grey, "quad");
+    const int res = 16;  // borders at texel centres x = 0.5 and 10.5, y = 0.5 and 6.5
+    scene.meshes[0].primitives[0].uv1 = {glm::vec2(0.5f, 0.5f) / float(res), glm::vec2(10.5f, 0.5f) / float(res),
+                                         glm::vec2(10.5f, 6.5f) / float(res), glm::vec2(0.5f, 6.5f) / float(res)};
+    LayoutOptions lo;
+    lo.mode = UvLayout::Asset;
+    lo.resolution = res;
+    auto layout = computeLayout(scene, lo);
+    ASSERT_TRUE(layout) << layout.error();
+    BakeOptions bo;
+    bo.directions = 1;
+    auto gpu = test::bakeGpu(scene, *layout, bo);
+    ASSERT_TRUE(gpu) << gpu.error();
+    ReferenceOptions ro;
+    ro.spp = 1;
+    auto cpu = test::bakeReference(scene, *layout, ro);
+    ASSERT_TRUE(cpu) << cpu.error();
+    int both = 0, onlyGpu = 0, onlyCpu = 0;
+    for (size_t i = 0; i < gpu->covered[0].size(); ++i) {
+        const bool g = gpu->covered[0][i], c = cpu->covered[0][i];
+        both += g && c;
+        onlyGpu += g && !c;
+        onlyCpu += c && !g;
+    }
+    EXPECT_EQ(both, 60) << "10 x 6 texel centres lie inside or on the left and bottom borders";
+    EXPECT_EQ(onlyGpu, 0);
+    EXPECT_EQ(onlyCpu, 0);
 }
 
 }  // namespace
