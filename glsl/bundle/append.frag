@@ -34,7 +34,7 @@ uniform int backLayerOffset;  // BACK_SIDES: double-sided triangles' back sides'
 
 void main() {
     ivec2 pixel = ivec2(gl_FragCoord.xy);  // in the drawn window (the head image)
-    bool owned = all(greaterThanEqual(pixel, ownedPixels.xy)) && all(lessThan(pixel, ownedPixels.zw));
+    bool owned = ownedPixel(pixel);
     ivec2 leafPixel = pixel + tileOffset;
     vec2 centre = vec2(leafPixel) + 0.5;
     // a cut-out's cut-away part is not there: no node, light goes through

@@ -56,14 +56,13 @@ void main() {
     if (emitterDoubleSided ? abs(facing) <= planeEpsilon : facing <= planeEpsilon) return;
     float f = polygonFormFactor(x, n, emitterA, emitterB, emitterC);
     if (f <= 0.0) return;
-    // the sample's weight; below x's horizon 0
+    // the sample's weight and visibility; below x's horizon it counts in F's mean only
     float r2 = dot(toX, toX);
     float cosX = -dot(n, toX), cosE = abs(dot(emitterNormal, toX));
-    if (cosX <= 0.0) {
-        imageStore(sums, texel, imageLoad(sums, texel) + vec4(f, 0.0, 0.0, 0.0));
-        return;
+    float w = 0.0, seen = 0.0;
+    if (cosX > 0.0) {
+        w = cosX * cosE / (r2 * r2);
+        seen = occludedFromLight(x, cross(positionDx, positionDy), samplePoint) ? 0.0 : 1.0;
     }
-    float w = cosX * cosE / (r2 * r2);
-    float seen = occludedFromLight(x, cross(positionDx, positionDy), samplePoint) ? 0.0 : 1.0;
     imageStore(sums, texel, imageLoad(sums, texel) + vec4(f, w * seen, w, 0.0));
 }

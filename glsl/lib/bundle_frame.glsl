@@ -21,6 +21,10 @@ uniform ivec2 tileOffset;    // the drawn window's first pixel in the leaf's gri
 uniform ivec2 tileSize;      // the drawn window's pixels: the tile's own and a one-pixel apron within the leaf
 uniform ivec4 ownedPixels;   // the tile's own pixels in the head image: [xy, zw)
 
+// Whether head-image pixel p is the tile's own, or drawn at all (own or apron).
+bool ownedPixel(ivec2 p) { return all(greaterThanEqual(p, ownedPixels.xy)) && all(lessThan(p, ownedPixels.zw)); }
+bool drawnPixel(ivec2 p) { return all(greaterThanEqual(p, ivec2(0))) && all(lessThan(p, tileSize)); }
+
 vec3 bundleFromWorld(vec3 p) { return vec3(dot(p, bundleU), dot(p, bundleV), dot(p, bundleDir)); }
 
 // Root units: [0, 1]^2 spans the root square.

@@ -226,7 +226,7 @@ void main() {
     if (!leafOwns(q)) return;  // another leaf's
     vec2 g = gridFromRoot(q);
     ivec2 pixel = min(ivec2(floor(g)), ivec2(leafPixels - 1)) - tileOffset;
-    if (any(lessThan(pixel, ownedPixels.xy)) || any(greaterThanEqual(pixel, ownedPixels.zw))) return;  // another tile's
+    if (!ownedPixel(pixel)) return;  // another tile's
 
     // The side the texel looks to is its triangle's (ng, the side the bundle
     // pass gives the triangle's own fragments); its shading normal n weighs the
@@ -263,7 +263,7 @@ void main() {
         ivec2 toward = ivec2(offset.x < 0.0 ? -1 : 1, offset.y < 0.0 ? -1 : 1);
         for (int k = 0; k < 3 && self == NO_CROSSING; ++k) {
             ivec2 step = order[k] * toward, neighbour = pixel + step;
-            if (any(lessThan(neighbour, ivec2(0))) || any(greaterThanEqual(neighbour, tileSize))) continue;
+            if (!drawnPixel(neighbour)) continue;
             self = ownCrossing(own, neighbour, offset - vec2(step) * pixelSize);
             if (self != NO_CROSSING) pixel = neighbour;
         }

@@ -26,7 +26,7 @@
 #include "layout/layout.h"
 #include "scene/scene.h"
 #include "support/gl_fixture.h"
-#include "scratch_dirs.h"
+#include "support/scratch_dirs.h"
 
 namespace bb::test {
 

@@ -3,6 +3,7 @@
 // process exits: each run would otherwise leave its own behind.
 #pragma once
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
 #include <system_error>
@@ -20,7 +21,7 @@ inline std::string removeAtExit(const std::string& path) {
         }
     };
     static Paths paths;  // one per process (inline function): destroyed at exit
-    paths.list.push_back(path);
+    if (std::find(paths.list.begin(), paths.list.end(), path) == paths.list.end()) paths.list.push_back(path);
     return path;
 }
 
