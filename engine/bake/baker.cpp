@@ -26,6 +26,32 @@ namespace {
 // One page of dilation codes (glsl/shared/bundle_layout.h), in place: covered
 // texels hold DILATION_SELF; every other texel gets the nearest covered texel
 // within `radius` (Euclidean, ties to the first in row order), or DILATION_NONE.
+// One page's CHART_NEIGHBOUR_* bits (glsl/shared/bundle_layout.h): for each
+// texel the GPU covered (codes before dilation), the texels 1 and 2 away
+// along its row and column that the GPU covered and whose CPU owners
+// (texelOwners) are on the same chart as its own, 2 away only through 1 away.
+void chartNeighbourBits(const std::vector<uint8_t>& codes, const std::vector<int64_t>& owner,
+                        const std::vector<uint32_t>& chart, int res, std::vector<uint8_t>& bits) {
+    const int dx[4] = {-1, 1, 0, 0}, dy[4] = {0, 0, -1, 1};
+    const uint8_t bit[4] = {CHART_NEIGHBOUR_LEFT, CHART_NEIGHBOUR_RIGHT, CHART_NEIGHBOUR_DOWN, CHART_NEIGHBOUR_UP};
+    for (int y = 0; y < res; ++y)
+        for (int x = 0; x < res; ++x) {
+            const size_t i = size_t(y) * res + x;
+            bits[i] = 0;
+            if (codes[i] != DILATION_SELF || owner[i] < 0) continue;
+            auto sameChart = [&](int nx, int ny) {
+                if (nx < 0 || ny < 0 || nx >= res || ny >= res) return false;
+                const size_t j = size_t(ny) * res + nx;
+                return codes[j] == DILATION_SELF && owner[j] >= 0 && chart[size_t(owner[j])] == chart[size_t(owner[i])];
+            };
+            for (int k = 0; k < 4; ++k) {
+                if (!sameChart(x + dx[k], y + dy[k])) continue;
+                bits[i] |= bit[k];
+                if (sameChart(x + 2 * dx[k], y + 2 * dy[k])) bits[i] |= bit[k] << CHART_NEIGHBOUR_FAR;
+            }
+        }
+}
+
 void dilationCodes(std::vector<uint8_t>& codes, int res, int radius) {
     for (int y = 0; y < res; ++y)
         for (int x = 0; x < res; ++x) {
@@ -262,10 +288,14 @@ void Baker::Impl::coveragePass() {
     // padding: the nearest covered texel, page by page on the CPU (once)
     const int res = layout.resolution;
     const int radius = std::min(std::max(layout.padding, 1) + 1, DILATION_RADIUS);
-    std::vector<uint8_t> codes(size_t(res) * res);
+    std::vector<uint8_t> codes(size_t(res) * res), neighbours(codes.size());
+    const std::vector<uint32_t> chart = findLightmapCharts(mesh);
     for (int p = 0; p < layout.pageCount; ++p) {
         gl::readTexture(dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, codes.data());
         stats.coveredTexels += std::count(codes.begin(), codes.end(), uint8_t(DILATION_SELF));
+        chartNeighbourBits(codes, texelOwners(mesh, p, res), chart, res, neighbours);
+        gl::writeTexture(chartNeighbours.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1,
+                         neighbours.data());
         dilationCodes(codes, res, radius);
         gl::writeTexture(dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, codes.data());
     }
@@ -440,11 +470,13 @@ Status Baker::Impl::init(const Scene& scene) {
         radiance = gl::Texture::create2DArray("outgoing radiance (RGB9E5)", GL_RGB9_E5, res, res, stateLayers());
         direct = gl::Texture::create2DArray("direct light (fp16)", GL_RGBA16F, res, res, pages);
         dilation = gl::Texture::create2DArray("dilation codes", GL_R8UI, res, res, pages);
+        chartNeighbours = gl::Texture::create2DArray("same-chart neighbours", GL_R8UI, res, res, pages);
         accumAsFloat = gl::Texture::createView("accumulators as rg32f (direct light sums)", accum, GL_RG32F);
         radianceBits = gl::Texture::createView("outgoing radiance as r32ui", radiance, GL_R32UI);
         radianceAsFloat = gl::Texture::createView("outgoing radiance as r32f (direct light sums)", radiance, GL_R32F);
     }
-    stats.lightmapStateBytes = accum.bytes() + radiance.bytes() + direct.bytes() + dilation.bytes();
+    stats.lightmapStateBytes =
+        accum.bytes() + radiance.bytes() + direct.bytes() + dilation.bytes() + chartNeighbours.bytes();
     {
         // the noise estimate's half: about 256^2 sampled texels a page, every texel of small pages
         MemoryCategory category("noise estimate");
@@ -528,7 +560,7 @@ Status Baker::Impl::init(const Scene& scene) {
         // the bundle pass: its buffers start small and grow to what the tiles predict
         MemoryCategory category("bundles");
         const BundleScene scene{&mesh, &clusters, vao.id(), vertexBuffer.id(), triangleBuffer.id(), radiance.id(),
-                                pageFbo.id(), res, materialAlphaBuffer.id(), alphaTexelBuffer.id(), backLayerOffset};
+                                chartNeighbours.id(), pageFbo.id(), res, materialAlphaBuffer.id(), alphaTexelBuffer.id(), backLayerOffset};
         const BundleLimits limits{nodeCapacity, maxTileSize, subpixelBits, options.predictTiles};
         auto t = BundleTracer::create(scene, limits, roundingDefine() + backSidesDefine(), &stats);
         if (!t) return t.status();

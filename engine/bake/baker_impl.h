@@ -50,11 +50,12 @@ struct Baker::Impl {
     // GL objects
     gl::Buffer vertexBuffer, triangleBuffer, metaIndexBuffer;
     gl::VertexArray vao;
-    // Light-map state, per page texel (21 bytes, 33 with back sides; BakeStats::memory):
+    // Light-map state, per page texel (22 bytes, 34 with back sides; BakeStats::memory):
     //   accum      RG32UI  the running mean of incoming radiance (fp16 RGB) and its weight (fp16)
     //   radiance   RGB9_E5 outgoing radiance Lo the bundle pass samples (meta.frag writes it)
     //   direct     RGBA16F direct light L_lm (sun + explicit emitters)
     //   dilation   R8UI    the covered texel each texel shows (DILATION_* codes)
+    //   chartNeighbours R8UI which 4-neighbours share the texel's chart (CHART_NEIGHBOUR_* bits)
     // While the direct light is baked, its float sums live in views of accum
     // and radiance (lib/direct_scratch.glsl). Albedo and emission are not
     // stored: the outgoing pass reads them from the materials.
@@ -62,7 +63,7 @@ struct Baker::Impl {
     // ceiling: its back reflects the ceiling's light onto it again), so a scene
     // with any has accum and radiance twice over: page p's back sides at layer
     // p + backLayerOffset (12 more bytes a texel; the direct light stays front-only).
-    gl::Texture accum, radiance, direct, dilation;
+    gl::Texture accum, radiance, direct, dilation, chartNeighbours;
     int backLayerOffset = 0;  // 0: no double-sided triangles, one layer per page
     int stateLayers() const { return layout.pageCount + backLayerOffset; }  // accum's and radiance's layers
     // The bundle and update programs handle back sides only when built with it:

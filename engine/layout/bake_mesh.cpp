@@ -75,6 +75,59 @@ std::vector<uint32_t> findLightmapCharts(const BakeMesh& mesh) {
     return chart;
 }
 
+std::vector<uint32_t> pageDrawOrder(const BakeMesh& mesh, int page) {
+    std::vector<uint32_t> order(mesh.pageFirstTriangle[size_t(page) + 1] - mesh.pageFirstTriangle[size_t(page)]);
+    std::iota(order.begin(), order.end(), mesh.pageFirstTriangle[size_t(page)]);
+    std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+        return mesh.triangles[a].material < mesh.triangles[b].material;
+    });
+    return order;
+}
+
+double pageCorners(const BakeMesh& mesh, uint32_t t, int res, glm::dvec2 (&q)[3]) {
+    for (int k = 0; k < 3; ++k) q[k] = glm::dvec2(mesh.vertices[3 * size_t(t) + k].lightmapUv) * double(res);
+    const glm::dvec2 e1 = q[1] - q[0], e2 = q[2] - q[0];
+    const double area2 = e1.x * e2.y - e1.y * e2.x;
+    if (area2 < 0) std::swap(q[1], q[2]);
+    return std::fabs(area2);
+}
+
+std::vector<int64_t> texelOwners(const BakeMesh& mesh, int page, int res) {
+    std::vector<int64_t> owner(size_t(res) * res, -1);
+    for (uint32_t t : pageDrawOrder(mesh, page)) {
+        glm::dvec2 q[3];
+        const double absArea = pageCorners(mesh, t, res, q);
+        if (absArea == 0.0 || !std::isfinite(absArea)) continue;
+        // GL's tie rule as Mesa applies it with the lower-left origin (D3D's
+        // top-left rule seen with y up; page space is GL's window space):
+        // counter-clockwise, an edge going down is a left edge, a horizontal
+        // edge going right a bottom edge; centres on them count. With the top
+        // edges instead, a chart whose borders ran through texel centres (a
+        // 10 m wall at 0.6 texels/m) was covered one row higher than the bake
+        bool topLeft[3];
+        for (int e = 0; e < 3; ++e) {
+            const glm::dvec2 a = q[(e + 1) % 3], b = q[(e + 2) % 3];  // edge opposite vertex e
+            topLeft[e] = (b.y < a.y) || (b.y == a.y && b.x > a.x);
+        }
+        const double minX = std::min({q[0].x, q[1].x, q[2].x}), maxX = std::max({q[0].x, q[1].x, q[2].x});
+        const double minY = std::min({q[0].y, q[1].y, q[2].y}), maxY = std::max({q[0].y, q[1].y, q[2].y});
+        const int x0 = std::max(0, int(std::floor(minX - 0.5))), x1 = std::min(res - 1, int(std::ceil(maxX - 0.5)));
+        const int y0 = std::max(0, int(std::floor(minY - 0.5))), y1 = std::min(res - 1, int(std::ceil(maxY - 0.5)));
+        for (int y = y0; y <= y1; ++y)
+            for (int x = x0; x <= x1; ++x) {
+                const glm::dvec2 c(x + 0.5, y + 0.5);
+                bool inside = true;
+                for (int e = 0; e < 3 && inside; ++e) {
+                    const glm::dvec2 a = q[(e + 1) % 3], b = q[(e + 2) % 3];
+                    const double w = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+                    inside = w > 0.0 || (w == 0.0 && topLeft[e]);
+                }
+                if (inside) owner[size_t(y) * res + x] = t;
+            }
+    }
+    return owner;
+}
+
 BakeMesh buildBakeMesh(const Scene& scene, const Layout& layout) {
     CHECK_EQ(layout.rects.size(), scene.instances.size());
     const size_t pageCount = size_t(layout.pageCount);

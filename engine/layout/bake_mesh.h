@@ -60,4 +60,19 @@ BakeMesh buildBakeMesh(const Scene& scene, const Layout& layout);
 // from one source vertex). Returns a chart id per triangle.
 std::vector<uint32_t> findLightmapCharts(const BakeMesh& mesh);
 
+// Page `page`'s triangles in the GPU meta pass's draw order (by material, stable).
+std::vector<uint32_t> pageDrawOrder(const BakeMesh& mesh, int page);
+
+// Triangle t's corners in page space, in texels of a res x res page, counter-
+// clockwise. Returns twice its area (0 or not finite: degenerate).
+double pageCorners(const BakeMesh& mesh, uint32_t t, int res, glm::dvec2 (&q)[3]);
+
+// Coverage on the CPU: per texel of the page (row-major, res x res), the
+// triangle whose page-space triangle holds the texel's centre, or -1. Ties
+// follow GL's rule as Mesa applies it (left and bottom edges count); where
+// triangles overlap, the last in pageDrawOrder wins, as in the GPU's coverage
+// pass (llvmpipe snaps to 1/256 texel, so a centre exactly on an edge may
+// still differ).
+std::vector<int64_t> texelOwners(const BakeMesh& mesh, int page, int res);
+
 }  // namespace bb

@@ -396,50 +396,8 @@ void ReferenceBaker::Impl::findTexels() {
     const int res = layout.resolution;
     const std::vector<uint32_t> chart = findLightmapCharts(mesh);
     for (int page = 0; page < layout.pageCount; ++page) {
-        std::vector<uint32_t> order;
-        for (uint32_t t = mesh.pageFirstTriangle[page]; t < mesh.pageFirstTriangle[page + 1]; ++t) order.push_back(t);
-        std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
-            return mesh.triangles[a].material < mesh.triangles[b].material;
-        });
-        // page-space corners, counter-clockwise (their order does not matter for the pieces)
-        auto corners = [&](uint32_t t, glm::dvec2 (&q)[3]) {
-            for (int k = 0; k < 3; ++k) q[k] = glm::dvec2(mesh.vertices[3 * t + k].lightmapUv) * double(res);
-            double area2 = cross2(q[1] - q[0], q[2] - q[0]);
-            if (area2 < 0) std::swap(q[1], q[2]);
-            return std::fabs(area2);
-        };
-        std::vector<int64_t> owner(size_t(res) * res, -1);
-        for (uint32_t t : order) {
-            glm::dvec2 q[3];
-            const double absArea = corners(t, q);
-            if (absArea == 0.0 || !std::isfinite(absArea)) continue;
-            // GL's tie rule as Mesa applies it with the lower-left origin (D3D's
-            // top-left rule seen with y up; page space is GL's window space):
-            // counter-clockwise, an edge going down is a left edge, a horizontal
-            // edge going right a bottom edge; centres on them count. With the top
-            // edges instead, a chart whose borders ran through texel centres (a
-            // 10 m wall at 0.6 texels/m) was covered one row higher than the bake
-            bool topLeft[3];
-            for (int e = 0; e < 3; ++e) {
-                const glm::dvec2 a = q[(e + 1) % 3], b = q[(e + 2) % 3];  // edge opposite vertex e
-                topLeft[e] = (b.y < a.y) || (b.y == a.y && b.x > a.x);
-            }
-            double minX = std::min({q[0].x, q[1].x, q[2].x}), maxX = std::max({q[0].x, q[1].x, q[2].x});
-            double minY = std::min({q[0].y, q[1].y, q[2].y}), maxY = std::max({q[0].y, q[1].y, q[2].y});
-            int x0 = std::max(0, int(std::floor(minX - 0.5))), x1 = std::min(res - 1, int(std::ceil(maxX - 0.5)));
-            int y0 = std::max(0, int(std::floor(minY - 0.5))), y1 = std::min(res - 1, int(std::ceil(maxY - 0.5)));
-            for (int y = y0; y <= y1; ++y)
-                for (int x = x0; x <= x1; ++x) {
-                    const glm::dvec2 c(x + 0.5, y + 0.5);
-                    bool inside = true;
-                    for (int e = 0; e < 3 && inside; ++e) {
-                        const glm::dvec2 a = q[(e + 1) % 3], b = q[(e + 2) % 3];
-                        const double w = cross2(b - a, c - a);
-                        inside = w > 0.0 || (w == 0.0 && topLeft[e]);
-                    }
-                    if (inside) owner[size_t(y) * res + x] = t;
-                }
-        }
+        const std::vector<uint32_t> order = pageDrawOrder(mesh, page);
+        const std::vector<int64_t> owner = texelOwners(mesh, page, res);
         std::vector<int64_t> slot(owner.size(), -1);  // texel -> index into texels
         const size_t firstTexel = texels.size();
         for (size_t i = 0; i < owner.size(); ++i) {
@@ -455,7 +413,7 @@ void ReferenceBaker::Impl::findTexels() {
         std::vector<std::pair<uint32_t, FootprintPiece>> found;  // (texel, piece)
         for (uint32_t t : order) {
             glm::dvec2 q[3];
-            const double absArea = corners(t, q);
+            const double absArea = pageCorners(mesh, t, res, q);
             if (absArea == 0.0 || !std::isfinite(absArea)) continue;
             double minX = std::min({q[0].x, q[1].x, q[2].x}), maxX = std::max({q[0].x, q[1].x, q[2].x});
             double minY = std::min({q[0].y, q[1].y, q[2].y}), maxY = std::max({q[0].y, q[1].y, q[2].y});

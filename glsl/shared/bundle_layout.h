@@ -45,6 +45,15 @@ struct Node {
 #define BINDING_RADIANCE 0       // texture unit: RGB9_E5 outgoing radiance Lo per texel, array of pages
 #define BINDING_ENV 1            // texture unit: environment map (equirectangular)
 #define BINDING_MATERIAL_TEX 2   // texture unit: a material's albedo texture (emission: + 1)
+#define BINDING_CHART_NEIGHBOURS 4  // texture unit: r8ui per texel: CHART_NEIGHBOUR_* bits, its neighbours on its chart
+
+// Which texels along a covered texel's row and column, 1 and 2 away, are
+// covered by the same chart (r8ui bits; 2 away only where 1 away is too)
+#define CHART_NEIGHBOUR_LEFT 1u   // x - 1
+#define CHART_NEIGHBOUR_RIGHT 2u  // x + 1
+#define CHART_NEIGHBOUR_DOWN 4u   // y - 1
+#define CHART_NEIGHBOUR_UP 8u     // y + 1
+#define CHART_NEIGHBOUR_FAR 4u    // shift: the same bits for x - 2, x + 2, y - 2, y + 2
 
 // Dilation codes (r8ui): the covered texel whose value an uncovered one shows,
 // at offset (code & 15, code >> 4) - DILATION_RADIUS; a covered texel shows itself.
