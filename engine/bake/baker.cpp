@@ -23,9 +23,6 @@
 namespace bb {
 namespace {
 
-// One page of dilation codes (glsl/shared/bundle_layout.h), in place: covered
-// texels hold DILATION_SELF; every other texel gets the nearest covered texel
-// within `radius` (Euclidean, ties to the first in row order), or DILATION_NONE.
 // One page's CHART_NEIGHBOUR_* bits (glsl/shared/bundle_layout.h): for each
 // texel the GPU covered (codes before dilation), the texels 1 and 2 away
 // along its row and column that the GPU covered and whose CPU owners
@@ -52,6 +49,9 @@ void chartNeighbourBits(const std::vector<uint8_t>& codes, const std::vector<int
         }
 }
 
+// One page of dilation codes (glsl/shared/bundle_layout.h), in place: covered
+// texels hold DILATION_SELF; every other texel gets the nearest covered texel
+// within `radius` (Euclidean, ties to the first in row order), or DILATION_NONE.
 void dilationCodes(std::vector<uint8_t>& codes, int res, int radius) {
     for (int y = 0; y < res; ++y)
         for (int x = 0; x < res; ++x) {
@@ -158,6 +158,7 @@ Status Baker::Impl::buildPrograms() {
         {&metaProgram, {"lightmap/meta.vert", "lightmap/meta.frag"}, rounding},
         {&coverageProgram, {"lightmap/meta.vert", "lightmap/meta.frag"}, "#define COVERAGE 1\n"},
         {&dilateProgram, {"lightmap/dilate.comp"}, ""},
+        {&readModesProgram, {"lightmap/read_modes.comp"}, ""},
         {&directFoldProgram, {"lightmap/direct_fold.comp"}, rounding},
         {&distanceProgram, {"direct/distance.vert", "direct/distance.frag"}, ""},
         {&emitterProgram, {"direct/emitter.vert", "direct/emitter.frag"}, ""},
@@ -471,12 +472,13 @@ Status Baker::Impl::init(const Scene& scene) {
         direct = gl::Texture::create2DArray("direct light (fp16)", GL_RGBA16F, res, res, pages);
         dilation = gl::Texture::create2DArray("dilation codes", GL_R8UI, res, res, pages);
         chartNeighbours = gl::Texture::create2DArray("same-chart neighbours", GL_R8UI, res, res, pages);
+        readModes = gl::Texture::create2DArray("radiance read modes", GL_R8UI, res, res, stateLayers());
         accumAsFloat = gl::Texture::createView("accumulators as rg32f (direct light sums)", accum, GL_RG32F);
         radianceBits = gl::Texture::createView("outgoing radiance as r32ui", radiance, GL_R32UI);
         radianceAsFloat = gl::Texture::createView("outgoing radiance as r32f (direct light sums)", radiance, GL_R32F);
     }
     stats.lightmapStateBytes =
-        accum.bytes() + radiance.bytes() + direct.bytes() + dilation.bytes() + chartNeighbours.bytes();
+        accum.bytes() + radiance.bytes() + direct.bytes() + dilation.bytes() + chartNeighbours.bytes() + readModes.bytes();
     {
         // the noise estimate's half: about 256^2 sampled texels a page, every texel of small pages
         MemoryCategory category("noise estimate");
@@ -559,8 +561,9 @@ Status Baker::Impl::init(const Scene& scene) {
     {
         // the bundle pass: its buffers start small and grow to what the tiles predict
         MemoryCategory category("bundles");
-        const BundleScene scene{&mesh, &clusters, vao.id(), vertexBuffer.id(), triangleBuffer.id(), radiance.id(),
-                                chartNeighbours.id(), pageFbo.id(), res, materialAlphaBuffer.id(), alphaTexelBuffer.id(), backLayerOffset};
+        const BundleScene scene{&mesh, &clusters, vao.id(), vertexBuffer.id(), triangleBuffer.id(),
+                                radiance.id(), readModes.id(), pageFbo.id(), res,
+                                materialAlphaBuffer.id(), alphaTexelBuffer.id(), backLayerOffset};
         const BundleLimits limits{nodeCapacity, maxTileSize, subpixelBits, options.predictTiles};
         auto t = BundleTracer::create(scene, limits, roundingDefine() + backSidesDefine(), &stats);
         if (!t) return t.status();

@@ -49,7 +49,7 @@ struct BundleScene {
     const std::vector<Cluster>* clusters = nullptr;
     GLuint vertexArray = 0, vertexBuffer = 0, triangleBuffer = 0;
     GLuint radiance = 0;      // outgoing radiance per texel (the bundle pass reads it)
-    GLuint chartNeighbours = 0;  // per texel, which 4-neighbours share its chart (the bundle pass's slopes)
+    GLuint readModes = 0;     // per texel, how the bundle pass reads its radiance (lightmap/read_modes.comp)
     GLuint pageFramebuffer = 0;
     int pageResolution = 0;
     // cut-outs (glsl/shared/material_layout.h): per material alpha and the masks' texels

@@ -185,6 +185,12 @@ void Baker::Impl::refreshRadiance(uint32_t key) {
     glBindImageTexture(BINDING_DILATION, dilation.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_R8UI);
     glBindImageTexture(BINDING_RADIANCE_BITS, radianceBits.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32UI);
     dispatchPages(dilateProgram.id(), stateLayers());
+    glUseProgram(readModesProgram.id());
+    glUniform1i(readModesProgram.uniform("codePages"), layout.pageCount);
+    glBindImageTexture(BINDING_CHART_NEIGHBOURS_IMAGE, chartNeighbours.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_R8UI);
+    glBindImageTexture(BINDING_RADIANCE_BITS, radianceBits.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_R32UI);
+    glBindImageTexture(BINDING_READ_MODES_IMAGE, readModes.id(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R8UI);
+    dispatchPages(readModesProgram.id(), stateLayers());
 }
 
 void Baker::Impl::resolveInto(const gl::Texture& target, int y0, int rows, int page0, int pages) {

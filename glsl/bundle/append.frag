@@ -27,7 +27,7 @@ layout(binding = BINDING_NODE_COUNTER, offset = 4) uniform atomic_uint ownedCoun
 layout(binding = BINDING_HEADS, r32ui) uniform coherent uimage2D heads;
 layout(std430, binding = BINDING_NODES) buffer Nodes { Node nodes[]; };
 layout(binding = BINDING_RADIANCE) uniform sampler2DArray radiance;
-layout(binding = BINDING_CHART_NEIGHBOURS) uniform usampler2DArray chartNeighbours;
+layout(binding = BINDING_READ_MODES) uniform usampler2DArray readModes;
 
 uniform uint nodeCapacity;
 uniform uint randomSeed;  // per direction and leaf (not per tile: tiles change with the budget, the bytes must not)
@@ -40,47 +40,46 @@ vec3 limitedSlope(vec3 a, vec3 b) {
     return mix(vec3(0.0), sign(a) * min(abs(a + b) * 0.5, 2.0 * min(abs(a), abs(b))), greaterThan(a * b, vec3(0.0)));
 }
 
-// A step inside a texel is taken where the two sides are this flat against it
-const float STEP_FLATNESS = 0.2;
-
 // The offset from the texel's mean m at position x in [-1/2, 1/2] along one
-// axis, from the texels 2 and 1 before (l2, l) and 1 and 2 after (r, r2) on
-// the same chart (missing ones repeat the next one in). Where m lies between
-// l and r and both sides are flat against the jump from l to r, the texel
-// holds a step (a shadow's edge, a contact, a slot's rim): the r side's share
-// f = (m - l) / (r - l) of the texel reads r, the rest l (Harten's subcell
-// resolution); elsewhere the limited slope. Either keeps the texel's mean.
-vec3 axisOffset(vec3 l2, vec3 l, vec3 m, vec3 r, vec3 r2, float x) {
-    vec3 a = m - l, b = r - m, jump = r - l;
+// axis, from its neighbours l before and r after on the same chart, as
+// lightmap/read_modes.comp decided: READ_STEP where a shadow's edge, a
+// contact or a slot's rim crosses the texel: the r side's share f = (m - l)
+// / (r - l) of it reads r, the rest l (Harten's subcell resolution, for cell
+// means); READ_SLOPE the limited slope; READ_NONE the mean. Each keeps the
+// texel's mean.
+vec3 axisOffset(uint mode, vec3 l, vec3 m, vec3 r, float x) {
+    vec3 a = m - l, b = r - m;
     bvec3 inside = greaterThan(a * b, vec3(0.0));
-    bvec3 flatSides = lessThanEqual(max(abs(l - l2), abs(r2 - r)), STEP_FLATNESS * abs(jump));
-    vec3 share = clamp(a / mix(vec3(1.0), jump, inside), 0.0, 1.0);
+    vec3 share = clamp(a / mix(vec3(1.0), r - l, inside), 0.0, 1.0);
     vec3 stepped = mix(l, r, vec3(greaterThan(vec3(x), 0.5 - share))) - m;
-    return mix(limitedSlope(a, b) * x, stepped, vec3(inside) * vec3(flatSides));
+    vec3 offset = mode == READ_STEP ? mix(vec3(0.0), stepped, inside) : limitedSlope(a, b) * x;
+    return mode == READ_NONE ? vec3(0.0) : offset;
 }
 
-// Outgoing radiance where a fragment lands, light-map position uv on page
-// `page`, layer `layer` (page or its back sides' layer): its texel's mean
-// plus an offset along each axis from the texels next to it on the same
-// chart (none from another chart or padding, so no light crosses), kept
-// within their range. A ray that meets the dark side of a texel a shadow, a
-// contact or a slot's rim crosses reads the dark side's light, not the
-// texel's mean (design notes, "Radiance reads").
-vec3 radianceAt(vec2 uv, int page, int layer) {
+// Outgoing radiance where a fragment lands, light-map position uv on layer
+// `layer` (its page or its back sides' layer): its texel's mean plus an
+// offset along each axis from the texels next to it on the same chart (none
+// from another chart or padding, so no light crosses), kept within their
+// range. A ray that meets the dark side of a texel a shadow, a contact or a
+// slot's rim crosses reads the dark side's light, not the texel's mean
+// (design notes, "Radiance reads"). Six fetches a fragment: what could be
+// decided once per texel is (read_modes.comp), as llvmpipe runs every fetch.
+vec3 radianceAt(vec2 uv, int layer) {
     ivec2 size = textureSize(radiance, 0).xy;
     vec2 t = uv * vec2(size) - 0.5;
     ivec2 c = clamp(ivec2(floor(t + 0.5)), ivec2(0), size - 1);
     vec2 f = clamp(t - vec2(c), vec2(-0.5), vec2(0.5));
-    uint same = texelFetch(chartNeighbours, ivec3(c, page), 0).r;
+    uint modes = texelFetch(readModes, ivec3(c, layer), 0).r;
     vec3 m = texelFetch(radiance, ivec3(c, layer), 0).rgb;
-    vec3 v[8];  // x - 1, x + 1, y - 1, y + 1, then 2 away
-    const ivec2 step[4] = ivec2[4](ivec2(-1, 0), ivec2(1, 0), ivec2(0, -1), ivec2(0, 1));
-    for (int k = 0; k < 4; ++k) {
-        v[k] = (same & (1u << k)) != 0u ? texelFetch(radiance, ivec3(c + step[k], layer), 0).rgb : m;
-        v[k + 4] = (same & (1u << (k + 4))) != 0u ? texelFetch(radiance, ivec3(c + 2 * step[k], layer), 0).rgb : v[k];
-    }
-    vec3 lo = min(min(min(v[0], v[1]), min(v[2], v[3])), m), hi = max(max(max(v[0], v[1]), max(v[2], v[3])), m);
-    return clamp(m + axisOffset(v[4], v[0], m, v[1], v[5], f.x) + axisOffset(v[6], v[2], m, v[3], v[7], f.y), lo, hi);
+    vec3 l = texelFetch(radiance, ivec3(max(c.x - 1, 0), c.y, layer), 0).rgb;
+    vec3 r = texelFetch(radiance, ivec3(min(c.x + 1, size.x - 1), c.y, layer), 0).rgb;
+    vec3 d = texelFetch(radiance, ivec3(c.x, max(c.y - 1, 0), layer), 0).rgb;
+    vec3 u = texelFetch(radiance, ivec3(c.x, min(c.y + 1, size.y - 1), layer), 0).rgb;
+    uint modeX = modes & 3u, modeY = (modes >> 2u) & 3u;
+    vec3 lo = m, hi = m;
+    if (modeX != READ_NONE) lo = min(lo, min(l, r)), hi = max(hi, max(l, r));
+    if (modeY != READ_NONE) lo = min(lo, min(d, u)), hi = max(hi, max(d, u));
+    return clamp(m + axisOffset(modeX, l, m, r, f.x) + axisOffset(modeY, d, m, u, f.y), lo, hi);
 }
 
 void main() {
@@ -98,7 +97,7 @@ void main() {
     vec3 u = vec3(uniform01(h), uniform01(pcgHash(h)), uniform01(pcgHash(h + 1u)));
     // the side the triangle's front faces (its texels' side, update.frag)
     uint front = dot(vFaceNormal, bundleDir) < 0.0 ? NODE_VISIBLE_FROM_BEHIND : NODE_VISIBLE_FROM_AHEAD;
-    uint radianceFront = encodeRgbe(radianceAt(lightmapUv, int(vPage), int(vPage)), u);
+    uint radianceFront = encodeRgbe(radianceAt(lightmapUv, int(vPage)), u);
     // A double-sided surface is seen from both sides: one node for both where
     // they look the same, else a second node at the same depth for its back
     // side's own radiance (update.frag tells the two apart by their sides),
@@ -109,7 +108,7 @@ void main() {
     // (only built for scenes with back sides: llvmpipe runs the fetch of a
     // branch no lane takes, 25 % of the pass)
     if (twoSides) {
-        vec3 lo = radianceAt(lightmapUv, int(vPage), int(vPage) + backLayerOffset);
+        vec3 lo = radianceAt(lightmapUv, int(vPage) + backLayerOffset);
         radianceBack = encodeRgbe(lo, u);
     }
 #endif

@@ -45,7 +45,15 @@ struct Node {
 #define BINDING_RADIANCE 0       // texture unit: RGB9_E5 outgoing radiance Lo per texel, array of pages
 #define BINDING_ENV 1            // texture unit: environment map (equirectangular)
 #define BINDING_MATERIAL_TEX 2   // texture unit: a material's albedo texture (emission: + 1)
-#define BINDING_CHART_NEIGHBOURS 4  // texture unit: r8ui per texel: CHART_NEIGHBOUR_* bits, its neighbours on its chart
+#define BINDING_READ_MODES 4     // texture unit: r8ui per texel: READ_* per axis (lightmap/read_modes.comp)
+#define BINDING_CHART_NEIGHBOURS_IMAGE 6  // image unit, read-modes pass only (the dilation's unit elsewhere)
+#define BINDING_READ_MODES_IMAGE 7        // image unit, read-modes pass only (the resolve target's unit elsewhere)
+
+// How the bundle pass reads a texel's radiance along an axis (2 bits an
+// axis, x in bits 0-1, y in 2-3): its mean, a limited slope, or a step
+#define READ_NONE 0u
+#define READ_SLOPE 1u
+#define READ_STEP 2u
 
 // Which texels along a covered texel's row and column, 1 and 2 away, are
 // covered by the same chart (r8ui bits; 2 away only where 1 away is too)
