@@ -151,6 +151,7 @@ struct Baker::Impl {
     void noteMemory();  // peaks into stats
     // The outgoing radiance the bundles read: meta.frag over every page, then the padding.
     void refreshRadiance(uint32_t key);  // key: the direction just done (random numbers)
+    void updateReadModes();              // readModes from the radiance map (after a refresh or a restore)
     // L_lm of the region (x 0.., y0.., page) + (width, rows, pages) into `target` at (0, 0, 0).
     void resolveInto(const gl::Texture& target, int y0, int rows, int page0, int pages);
     void dispatchPages(GLuint program, int layers = 0);  // layers: 0 = the pages

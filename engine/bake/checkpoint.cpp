@@ -233,6 +233,7 @@ Status Baker::loadCheckpoint(const std::string& path) {
     gl::writeTexture(m.accum.id(), 0, 0, 0, res, res, m.stateLayers(), GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
     gl::writeTexture(m.radianceBits.id(), 0, 0, 0, res, res, m.stateLayers(), GL_RED_INTEGER, GL_UNSIGNED_INT, 4,
                      radiance.data());
+    m.updateReadModes();  // derived from the radiance map, not saved
     gl::writeTexture(m.halfAccum.id(), 0, 0, 0, m.halfWidth, m.halfWidth, m.layout.pageCount, GL_RG_INTEGER,
                      GL_UNSIGNED_INT, 8, half.data());
     m.stats = restored;

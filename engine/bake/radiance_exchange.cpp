@@ -185,6 +185,11 @@ void Baker::Impl::refreshRadiance(uint32_t key) {
     glBindImageTexture(BINDING_DILATION, dilation.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_R8UI);
     glBindImageTexture(BINDING_RADIANCE_BITS, radianceBits.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32UI);
     dispatchPages(dilateProgram.id(), stateLayers());
+    updateReadModes();
+}
+
+void Baker::Impl::updateReadModes() {
+    gl::DebugGroup group("radiance read modes");
     glUseProgram(readModesProgram.id());
     glUniform1i(readModesProgram.uniform("codePages"), layout.pageCount);
     glBindImageTexture(BINDING_CHART_NEIGHBOURS_IMAGE, chartNeighbours.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_R8UI);
