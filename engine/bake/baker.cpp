@@ -488,16 +488,6 @@ Status Baker::Impl::init(const Scene& scene) {
                                                halfWidth, pages);
         noiseTerms = gl::Texture::create2DArray("noise estimate terms", GL_RGBA32F, halfWidth, halfWidth, pages);
     }
-    // a fragment reads the texel it lies in: its footprint's mean, the value
-    // the texel stands for. Bilinear reads blurred each radiance across a
-    // texel into the neighbours' charts and surfaces: dark walls of narrow
-    // slots between buildings whose charts sit less than a texel apart read
-    // 1.8x the reference (1.67x nearest), a contact's covered texels bled
-    // out; at 1024 directions the Cornell box 2.26 -> 2.17 %, the city under
-    // a sky 4.49 -> 4.19 %, the shared Cornell box 37.6 -> 33.6 %, the rest
-    // within 0.03 % (design notes, "Radiance reads")
-    glTextureParameteri(radiance.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTextureParameteri(radiance.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     const uint32_t zero[4] = {0, 0, 0, 0};
     clearAccumulators();
     glClearTexImage(radianceBits.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, zero);
