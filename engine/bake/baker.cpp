@@ -27,7 +27,7 @@ namespace {
 // texel the GPU covered (codes before dilation), the texels 1 and 2 away
 // along its row and column that the GPU covered and whose CPU owners
 // (texelOwners) are on the same chart as its own, 2 away only through 1 away.
-void chartNeighbourBits(const std::vector<uint8_t>& codes, const std::vector<int64_t>& owner,
+void chartNeighbourBits(const std::vector<uint8_t>& codes, const std::vector<int32_t>& owner,
                         const std::vector<uint32_t>& chart, int res, std::vector<uint8_t>& bits) {
     const int dx[4] = {-1, 1, 0, 0}, dy[4] = {0, 0, -1, 1};
     const uint8_t bit[4] = {CHART_NEIGHBOUR_LEFT, CHART_NEIGHBOUR_RIGHT, CHART_NEIGHBOUR_DOWN, CHART_NEIGHBOUR_UP};

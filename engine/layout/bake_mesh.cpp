@@ -92,8 +92,9 @@ double pageCorners(const BakeMesh& mesh, uint32_t t, int res, glm::dvec2 (&q)[3]
     return std::fabs(area2);
 }
 
-std::vector<int64_t> texelOwners(const BakeMesh& mesh, int page, int res) {
-    std::vector<int64_t> owner(size_t(res) * res, -1);
+std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res) {
+    CHECK(mesh.triangles.size() <= size_t(INT32_MAX));
+    std::vector<int32_t> owner(size_t(res) * res, -1);
     for (uint32_t t : pageDrawOrder(mesh, page)) {
         glm::dvec2 q[3];
         const double absArea = pageCorners(mesh, t, res, q);
@@ -122,7 +123,7 @@ std::vector<int64_t> texelOwners(const BakeMesh& mesh, int page, int res) {
                     const double w = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
                     inside = w > 0.0 || (w == 0.0 && topLeft[e]);
                 }
-                if (inside) owner[size_t(y) * res + x] = t;
+                if (inside) owner[size_t(y) * res + x] = int32_t(t);
             }
     }
     return owner;

@@ -73,6 +73,6 @@ double pageCorners(const BakeMesh& mesh, uint32_t t, int res, glm::dvec2 (&q)[3]
 // triangles overlap, the last in pageDrawOrder wins, as in the GPU's coverage
 // pass (llvmpipe snaps to 1/256 texel, so a centre exactly on an edge may
 // still differ).
-std::vector<int64_t> texelOwners(const BakeMesh& mesh, int page, int res);
+std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res);
 
 }  // namespace bb

@@ -397,7 +397,7 @@ void ReferenceBaker::Impl::findTexels() {
     const std::vector<uint32_t> chart = findLightmapCharts(mesh);
     for (int page = 0; page < layout.pageCount; ++page) {
         const std::vector<uint32_t> order = pageDrawOrder(mesh, page);
-        const std::vector<int64_t> owner = texelOwners(mesh, page, res);
+        const std::vector<int32_t> owner = texelOwners(mesh, page, res);
         std::vector<int64_t> slot(owner.size(), -1);  // texel -> index into texels
         const size_t firstTexel = texels.size();
         for (size_t i = 0; i < owner.size(); ++i) {

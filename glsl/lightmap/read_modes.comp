@@ -30,9 +30,11 @@ void main() {
     uint same = imageLoad(chartNeighbours, ivec3(t.xy, t.z % codePages)).r;
     float m = radianceSum(t);
     const ivec2 along[2] = ivec2[2](ivec2(1, 0), ivec2(0, 1));
+    const uint beforeBit[2] = uint[2](CHART_NEIGHBOUR_LEFT, CHART_NEIGHBOUR_DOWN);
+    const uint afterBit[2] = uint[2](CHART_NEIGHBOUR_RIGHT, CHART_NEIGHBOUR_UP);
     uint modes = 0u;
     for (int axis = 0; axis < 2; ++axis) {
-        uint before = 1u << (2 * axis), after = 2u << (2 * axis);  // CHART_NEIGHBOUR_LEFT/RIGHT, DOWN/UP
+        uint before = beforeBit[axis], after = afterBit[axis];
         if ((same & before) == 0u || (same & after) == 0u) continue;  // READ_NONE
         ivec3 s = ivec3(along[axis], 0);
         float l = radianceSum(t - s), r = radianceSum(t + s);

@@ -168,12 +168,6 @@ TEST(ReferenceVsBake, OpenBoxProbes) {
     }
 }
 
-}  // namespace
-}  // namespace bb
-
-namespace bb {
-namespace {
-
 // A chart whose borders run through texel centres: GL's rasterizer and the
 // reference settle the ties alike (left and bottom edges count, page space
 // being GL's window space), so both cover the same texels. The reference
