@@ -44,7 +44,8 @@ uint32_t reverseBits(uint32_t i) {
     return i;
 }
 
-// A uniformly distributed rotation matrix (Shoemake's random unit quaternion).
+}  // namespace
+
 glm::dmat3 randomRotation(uint64_t seed) {
     SplitMix64 rng{seed};
     const double u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
@@ -58,8 +59,6 @@ glm::dmat3 randomRotation(uint64_t seed) {
     m[2] = glm::dvec3(2.0 * (x * z + y * w), 2.0 * (y * z - x * w), 1.0 - 2.0 * (x * x + y * y));
     return m;
 }
-
-}  // namespace
 
 namespace {
 // One spherical Fibonacci set of `count` points over the hemisphere, rotated,

@@ -27,6 +27,10 @@ namespace bb {
 // count >= 1. Unit vectors; the same (count, seed) gives the same bits.
 std::vector<glm::vec3> makeDirections(int count, uint64_t seed);
 
+// A uniformly distributed rotation (Shoemake's random unit quaternion); the
+// same seed gives the same bits.
+glm::dmat3 randomRotation(uint64_t seed);
+
 // A right-handed orthonormal basis (u, v) with u x v = d, for bundle planes.
 void orthonormalBasis(const glm::vec3& d, glm::vec3& u, glm::vec3& v);
 

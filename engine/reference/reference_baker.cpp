@@ -20,6 +20,7 @@
 #endif
 
 #include "core/check.h"
+#include "core/hash.h"
 #include "core/timer.h"
 #include "core/log.h"
 
@@ -32,14 +33,6 @@ constexpr float INV_PI = 1.0f / PI;
 
 // --- random numbers -----------------------------------------------------------
 
-uint64_t mix64(uint64_t x) {  // splitmix64 finalizer
-    x += 0x9E3779B97F4A7C15ull;
-    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-    x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-    return x ^ (x >> 31);
-}
-uint64_t hash(uint64_t a, uint64_t b) { return mix64(a ^ mix64(b)); }
-uint64_t hash(uint64_t a, uint64_t b, uint64_t c) { return hash(hash(a, b), c); }
 
 // PCG32 (O'Neill 2014), one stream per (texel, sample).
 struct Pcg32 {

@@ -16,6 +16,7 @@
 layout(binding = 0) uniform samplerCube distances;
 uniform float rayOffset;  // scene units
 uniform int cubeSize;     // texels per face side
+uniform mat3 cubeFromWorld;  // the cube's orientation (a rotation; emitter samples turn theirs at random)
 
 // The centre ray of the cube texel a nearest lookup along w reads.
 vec3 cubeTexelCentre(vec3 w) {
@@ -33,8 +34,9 @@ vec3 cubeTexelCentre(vec3 w) {
 bool occludedFromLight(vec3 x, vec3 planeNormal, vec3 lightPoint) {
     vec3 fromLight = x - lightPoint;
     float dist = length(fromLight);
-    float stored = texture(distances, fromLight).r;
-    vec3 centreRay = cubeTexelCentre(fromLight);
+    vec3 inCube = cubeFromWorld * fromLight;
+    float stored = texture(distances, inCube).r;
+    vec3 centreRay = transpose(cubeFromWorld) * cubeTexelCentre(inCube);
     // where the centre ray meets x's plane: x's own surface along that ray
     // (within one bundle pixel of x's own distance: at a grazing angle it
     // meets the plane far from x, where a coplanar wall on the other side of

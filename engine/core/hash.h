@@ -1,0 +1,18 @@
+// 64-bit integer hashing for seeded, order-independent random numbers on the
+// CPU: the splitmix64 finalizer (Steele, Lea, Flood 2014) and its chaining.
+#pragma once
+
+#include <cstdint>
+
+namespace bb {
+
+inline uint64_t mix64(uint64_t x) {
+    x += 0x9E3779B97F4A7C15ull;
+    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+    x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+    return x ^ (x >> 31);
+}
+inline uint64_t hash(uint64_t a, uint64_t b) { return mix64(a ^ mix64(b)); }
+inline uint64_t hash(uint64_t a, uint64_t b, uint64_t c) { return hash(hash(a, b), c); }
+
+}  // namespace bb
