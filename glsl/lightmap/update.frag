@@ -178,6 +178,52 @@ float ownCrossing(OwnSurface own, ivec2 pixel, vec2 offset) {
     return self;
 }
 
+#ifndef SUN_PASS
+// Which pixel's ray a texel's sample takes (issue 11). A sample at a point x of
+// the footprint, read along the ray of the pixel x lies in, sees from where
+// that ray crosses the surface, up to half a pixel from x: the footprint is
+// read blurred by a pixel, and where the light changes within a pixel of a
+// contact (a light under a ceiling, a block's foot, a partition wall) the blur
+// carries light under the contact and takes it from beside it. So the sample
+// takes the ray of a pixel whose centre crosses the footprint itself. With the
+// grid's random phase per direction those crossings are spread uniformly over
+// the footprint, one per pixel cell; one of them is taken at random (the one
+// whose pixel hashes highest: the same pixels give the same choice whatever
+// the layout). The sample's weight stays the direction's: weighing it by how
+// many crossings the footprint holds (count / |det G|, exact in expectation)
+// made the weights noisy, and the steep history ramp of a high albedo read
+// the rho 0.99 furnace 2 % low. Where no pixel centre crosses the footprint
+// (a grazing direction) or more than 6 x 6 might (a leaf much finer than the
+// texel, where the blur is small), false: the footprint's own point instead.
+bool footprintPixel(vec2 centre, vec3 positionDx, vec3 positionDy, vec3 bary, vec3 baryDx, vec3 baryDy, uint flags,
+                    out vec2 offset) {
+    // columns: pixels per texel of offset along the light map's x and y
+    mat2 G = mat2(vec2(dot(positionDx, bundleU), dot(positionDx, bundleV)),
+                  vec2(dot(positionDy, bundleU), dot(positionDy, bundleV))) / pixelSize;
+    vec2 halfExtent = 0.5 * (abs(G[0]) + abs(G[1]));
+    ivec2 lo = ivec2(ceil(centre - halfExtent - 0.5)), hi = ivec2(floor(centre + halfExtent - 0.5));
+    ivec2 span = max(hi - lo + 1, ivec2(0));
+    if (span.x * span.y > 36 || abs(determinant(G)) < 1e-6) return false;
+    mat2 offsetFromPixel = inverse(G);
+    uint seed = pcgHash(randomSeed);
+    uint best = 0u;
+    bool found = false;
+    offset = vec2(0.0);
+    for (int y = lo.y; y <= hi.y; ++y)
+        for (int x = lo.x; x <= hi.x; ++x) {
+            vec2 o = offsetFromPixel * (vec2(x, y) + 0.5 - centre);
+            if (any(greaterThan(abs(o), vec2(0.5))) || offChart(bary, baryDx, baryDy, flags, o)) continue;
+            uint h = pcgHash(seed ^ (uint(x) * 0x9e3779b1u) ^ (uint(y) * 0x85ebca77u));
+            if (!found || h > best) {
+                best = h;
+                offset = o;
+                found = true;
+            }
+        }
+    return found;
+}
+#endif
+
 void main() {
     // the triangle's own plane, from screen derivatives (before any return:
     // derivatives need the whole quad)
@@ -194,8 +240,16 @@ void main() {
     // a texel half under a building reads half its outside value, as the
     // reference's does (the city under a sky: 6.6 % -> 5.3 % against it)
     ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), int(vPage));
+#ifndef SUN_PASS
+    // the leaf of the texel's centre takes its sample (a sample whose point
+    // lies in another leaf is lost, at random: leaves move with d)
+    vec2 centreRoot = rootFromBundle(bundleFromWorld(vPosition).xy);
+    if (!leafOwns(centreRoot)) return;
+    vec2 jitter;
+    if (!footprintPixel(gridFromRoot(centreRoot), positionDx, positionDy, vBary, baryDx, baryDy, vFlags, jitter))
+        jitter = footprintOffset(vBary, baryDx, baryDy, vFlags, footprintSample);
+#else
     vec2 jitter = footprintOffset(vBary, baryDx, baryDy, vFlags, footprintSample);
-#ifdef SUN_PASS
     // The sun's sample is where its pixel's ray meets the surface: the pixel
     // (jittered from run to run, bakeSun) spreads it too, by up to half a
     // pixel from the footprint's point. The point is spread over the texel
