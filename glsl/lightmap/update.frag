@@ -178,7 +178,6 @@ float ownCrossing(OwnSurface own, ivec2 pixel, vec2 offset) {
     return self;
 }
 
-#ifndef SUN_PASS
 // Which pixel's ray a texel's sample takes (issue 11). A sample at a point x of
 // the footprint, read along the ray of the pixel x lies in, sees from where
 // that ray crosses the surface, up to half a pixel from x: the footprint is
@@ -196,7 +195,7 @@ float ownCrossing(OwnSurface own, ivec2 pixel, vec2 offset) {
 // (a grazing direction) or more than 6 x 6 might (a leaf much finer than the
 // texel, where the blur is small), false: the footprint's own point instead.
 bool footprintPixel(vec2 centre, vec3 positionDx, vec3 positionDy, vec3 bary, vec3 baryDx, vec3 baryDy, uint flags,
-                    out vec2 offset) {
+                    uint seed, out vec2 offset) {
     // columns: pixels per texel of offset along the light map's x and y
     mat2 G = mat2(vec2(dot(positionDx, bundleU), dot(positionDx, bundleV)),
                   vec2(dot(positionDy, bundleU), dot(positionDy, bundleV))) / pixelSize;
@@ -205,7 +204,6 @@ bool footprintPixel(vec2 centre, vec3 positionDx, vec3 positionDy, vec3 bary, ve
     ivec2 span = max(hi - lo + 1, ivec2(0));
     if (span.x * span.y > 36 || abs(determinant(G)) < 1e-6) return false;
     mat2 offsetFromPixel = inverse(G);
-    uint seed = pcgHash(randomSeed);
     uint best = 0u;
     bool found = false;
     offset = vec2(0.0);
@@ -222,7 +220,6 @@ bool footprintPixel(vec2 centre, vec3 positionDx, vec3 positionDy, vec3 bary, ve
         }
     return found;
 }
-#endif
 
 void main() {
     // the triangle's own plane, from screen derivatives (before any return:
@@ -240,25 +237,29 @@ void main() {
     // a texel half under a building reads half its outside value, as the
     // reference's does (the city under a sky: 6.6 % -> 5.3 % against it)
     ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), int(vPage));
-#ifndef SUN_PASS
     // the leaf of the texel's centre takes its sample (a sample whose point
     // lies in another leaf is lost, at random: leaves move with d)
     vec2 centreRoot = rootFromBundle(bundleFromWorld(vPosition).xy);
     if (!leafOwns(centreRoot)) return;
-    vec2 jitter;
-    if (!footprintPixel(gridFromRoot(centreRoot), positionDx, positionDy, vBary, baryDx, baryDy, vFlags, jitter))
-        jitter = footprintOffset(vBary, baryDx, baryDy, vFlags, footprintSample);
+#ifdef SUN_PASS
+    uint pixelSeed = pcgHash(footprintSample + 0x632be5abu);
 #else
-    vec2 jitter = footprintOffset(vBary, baryDx, baryDy, vFlags, footprintSample);
-    // The sun's sample is where its pixel's ray meets the surface: the pixel
-    // (jittered from run to run, bakeSun) spreads it too, by up to half a
-    // pixel from the footprint's point. The point is spread over the texel
-    // less that, so the two together stay within the texel: a shadow edge
-    // along its border stays out of it. Where a pixel covers more than a
-    // texel (a grazing sun), the pixel's jitter alone spreads the samples.
-    float facing = length(faceNormal) > 0.0 ? abs(dot(normalize(faceNormal), bundleDir)) : 1.0;
-    jitter *= clamp(1.0 - pixelSize / (max(facing, 1e-3) * max(texelSize, 1e-30)), 0.0, 1.0);
+    uint pixelSeed = pcgHash(randomSeed);
 #endif
+    vec2 jitter;
+    if (!footprintPixel(gridFromRoot(centreRoot), positionDx, positionDy, vBary, baryDx, baryDy, vFlags, pixelSeed, jitter)) {
+        jitter = footprintOffset(vBary, baryDx, baryDy, vFlags, footprintSample);
+#ifdef SUN_PASS
+        // The sun's sample is where its pixel's ray meets the surface: the pixel
+        // (jittered from run to run, bakeSun) spreads it too, by up to half a
+        // pixel from the footprint's point. The point is spread over the texel
+        // less that, so the two together stay within the texel: a shadow edge
+        // along its border stays out of it. Where a pixel covers more than a
+        // texel (a grazing sun), the pixel's jitter alone spreads the samples.
+        float facing = length(faceNormal) > 0.0 ? abs(dot(normalize(faceNormal), bundleDir)) : 1.0;
+        jitter *= clamp(1.0 - pixelSize / (max(facing, 1e-3) * max(texelSize, 1e-30)), 0.0, 1.0);
+#endif
+    }
     vec3 position = vPosition + positionDx * jitter.x + positionDy * jitter.y;
     // the shading normal where the point leaves the triangle, not extrapolated
     // past it: a triangle far smaller than a texel (300 to a texel on the
