@@ -75,7 +75,10 @@ struct BakeOptions {
     // bundles carry emission like any radiance; Auto = Explicit when emitters
     // are at most 1024 triangles and 25% of the surface area.
     enum class DirectLight { Auto, Explicit, Bundles } directLight = DirectLight::Auto;
-    int emitterSamples = 128;         // visibility samples over all explicit emitters (>= 1 per triangle)
+    // visibility samples over all explicit emitters (>= 1 per triangle); 0 =
+    // max(128, directions / 4), so that the direct light's noise keeps
+    // falling with the directions as the bounces' does
+    int emitterSamples = 0;
     int emitterShadowSize = 0;        // cube face size of each sample's distance map; 0 = from the bundle
                                       // resolution (4 cube texels per bundle pixel), 64..512
     // Directions shared with other bakers (MPI ranks; bake/direction_share.h):

@@ -118,6 +118,7 @@ struct Baker::Impl {
     void bakeSun();
     void foldDirect(bool perSample);
     bool useExplicitEmitters() const;
+    int emitterSamples() const;  // options.emitterSamples, or its automatic count
     void bakeEmitters();
     void uploadAlphaMasks(const Scene& scene);      // cutouts.cpp: the tables, bound at their SSBO bindings
     void bindAlphaMasks() const;

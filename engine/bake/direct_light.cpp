@@ -131,18 +131,20 @@ bool Baker::Impl::useExplicitEmitters() const {
     return emitters > 0 && emitters <= 1024 && emitterArea <= 0.25 * area;
 }
 
+int Baker::Impl::emitterSamples() const {
+    return options.emitterSamples > 0 ? options.emitterSamples : std::max(128, options.directions / 4);
+}
+
 // auto: 4 cube texels per bundle pixel across (gridSize pixels span the
-// scene's diameter). Measured on the Cornell box at 64^2 texels: 64^2 faces
-// raise the error from 4.3 % to 5.0 %, 256^2 and 512^2 give 4.3 % and 256^2
-// costs 0.3 s instead of 0.5 s.
+// scene's diameter), 64..512. Measured on the Cornell box at 64^2 texels:
+// 64^2 faces raise the error from 4.3 % to 5.0 %, 256^2 and 512^2 give 4.3 %
+// and 256^2 costs 0.3 s instead of 0.5 s. (Until 2026-12-02 the size was
+// rounded up to a power of two: 512 for the Cornell box's 67 pixels, 2.5x
+// the cost of a sample at 268.)
 namespace {
 int shadowCubeSize(const Baker::Impl& m) {
-    int size = m.options.emitterShadowSize;
-    if (size <= 0) {
-        size = 64;
-        while (size < 4 * m.gridSize && size < 512) size *= 2;
-    }
-    return size;
+    const int size = m.options.emitterShadowSize;
+    return size > 0 ? size : std::clamp(4 * m.gridSize, 64, 512);
 }
 
 // One light's (an emitter sample's, a point or spot light's) irradiance times
@@ -192,7 +194,7 @@ void Baker::Impl::bakeEmitters() {
     if (emitters.empty()) return;
     bindAlphaMasks();
     for (auto& e : emitters)
-        e.samples = std::max(1, int(std::lround(options.emitterSamples * (totalPower > 0 ? e.power / totalPower : 0.0))));
+        e.samples = std::max(1, int(std::lround(emitterSamples() * (totalPower > 0 ? e.power / totalPower : 0.0))));
 
     DistanceCube cube(shadowCubeSize(*this), triangleBuffer.id(), int64_t(mesh.triangles.size()));
     const float nearPlane = 1e-4f * sphereRadius, farPlane = 4.0f * sphereRadius;

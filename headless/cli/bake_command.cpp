@@ -66,8 +66,9 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
                    "(explicit for small emitters)")
         ->check(CLI::IsMember({"auto", "explicit", "bundles"}))
         ->capture_default_str();
-    cmd.add_option("--emitter-samples", a.emitterSamples, "Visibility samples over all explicit emitters")
-        ->check(CLI::Range(1, 1 << 16))
+    cmd.add_option("--emitter-samples", a.emitterSamples,
+                   "Visibility samples over all explicit emitters (0 = max(128, directions / 4))")
+        ->check(CLI::Range(0, 1 << 16))
         ->capture_default_str();
     cmd.add_option("--target-noise", a.targetNoise,
                    "Stop once the estimated relative noise of the light maps is at most this (e.g. 0.01; checked at "

@@ -48,7 +48,7 @@ struct BakeArgs {
     std::string rounding = "stochastic";
     float historyPower = -1.0f;
     std::string direct = "auto";
-    int emitterSamples = 128;
+    int emitterSamples = 0;
     std::string seams = "stitch";     // stitch | off (bake/seam_stitch.h)
     bool preview = true;
     bool progress = true;
