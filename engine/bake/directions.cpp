@@ -13,6 +13,7 @@
 #include <cmath>
 
 #include "core/check.h"
+#include "core/hash.h"
 
 namespace bb {
 namespace {
@@ -24,10 +25,9 @@ constexpr double PI = 3.14159265358979323846;
 struct SplitMix64 {
     uint64_t state;
     uint64_t next() {
-        uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-        return z ^ (z >> 31);
+        const uint64_t z = mix64(state);  // the finalizer of state + the golden gamma
+        state += 0x9E3779B97F4A7C15ull;
+        return z;
     }
     // [0, 1) with 53 bits
     double uniform() { return double(next() >> 11) * 0x1.0p-53; }

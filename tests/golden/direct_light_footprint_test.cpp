@@ -7,9 +7,9 @@
 //
 // Measured at 64^2, 128 emitter samples, against the reference at 16384 spp:
 // relative RMSE 1.5 % (means within 0.05 %), and 2.7 % over the 404 texels at
-// an edge of the light (since the samples' random pairing below: 1.2 % and
-// 2.0 % against 4096 spp) (a covered neighbour differs by over 20 %: penumbrae,
-// chart borders); before the footprint, the ratio estimate and the
+// an edge of the light (a covered neighbour differs by over 20 %: penumbrae,
+// chart borders; since the samples' random pairing below, 1.2 % and 2.0 %
+// against 4096 spp); before the footprint, the ratio estimate and the
 // receiver-plane visibility: 6.6 % and 11.8 % (the tall block's penumbrae
 // 20-50 % dark). Here the reference runs 4096 spp (its own noise about
 // 0.8 %): tolerances 3 % on the RMSE, 1 % on the mean, 6 % at the edges.
