@@ -212,24 +212,21 @@ void Baker::Impl::bakeEmitters() {
         glm::vec3 a(v[0].position), b(v[1].position), c(v[2].position);
         glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
         bool doubleSided = mesh.triangles[e.triangle].flags & TRIANGLE_DOUBLE_SIDED;
-        // Sample i takes a point of every texel's footprint and a point of the
-        // triangle, together point i of a 4D low-discrepancy sequence (R4,
-        // Roberts 2018) shifted at random per emitter and seed: the pairs are
-        // stratified jointly, so a penumbra crossing the footprint is read at
-        // every pairing of the two points, evenly. (Footprint and light points
-        // both from the R2 sequence at one index lay on one lattice, their
-        // offsets tied: the Cornell box's direct light, every albedo 0, held
-        // at 1.1 % against the reference from 512 samples on. The two R2
-        // sequences paired in a random order read 1.21 / 0.59 / 0.39 % at 128
-        // / 512 / 2048 samples.)
-        const double g = 1.1673039782614187;  // the root of x^5 = x + 1
-        const glm::dvec4 alpha(1.0 / g, 1.0 / (g * g), 1.0 / (g * g * g), 1.0 / (g * g * g * g));
-        glm::dvec4 shift;
-        for (int j = 0; j < 4; ++j) shift[j] = double(hash(options.seed, e.triangle, uint64_t(j) + (2ull << 32)) >> 11) * 0x1.0p-53;
+        // Sample i takes point i of every texel's footprint and a point of the
+        // triangle: the first e.samples points of the R2 sequence (Roberts
+        // 2018), stratified over the triangle, in a seeded random order.
+        // Taken in sequence order, point i of the footprint and point i of
+        // the triangle lie on one lattice (both R2), so their offsets are
+        // tied, and a penumbra that crosses the footprint is read at one
+        // pairing only: the Cornell box's direct light (every albedo 0) held
+        // at 1.1 % against the reference from 512 samples on.
+        std::vector<std::pair<uint64_t, int>> order(size_t(e.samples));
+        for (int i = 0; i < e.samples; ++i) order[size_t(i)] = {hash(options.seed, e.triangle, uint64_t(i)), i};
+        std::sort(order.begin(), order.end());
         for (int i = 0; i < e.samples; ++i) {
-            const glm::dvec4 r = glm::fract(shift + alpha * double(i + 1));
-            const glm::vec2 footprint(r.x, r.y);
-            double su = r.z, sv = r.w;
+            const int k = order[size_t(i)].second + 1;
+            double su = std::fmod(0.5 + 0.7548776662466927 * k, 1.0);
+            double sv = std::fmod(0.5 + 0.5698402909980532 * k, 1.0);
             if (su + sv > 1.0) {
                 su = 1.0 - su;
                 sv = 1.0 - sv;
@@ -247,7 +244,6 @@ void Baker::Impl::bakeEmitters() {
             glUniform1i(emitterProgram.uniform("emitterDoubleSided"), doubleSided);
             glUniform3fv(emitterProgram.uniform("samplePoint"), 1, &point.x);
             glUniform1ui(emitterProgram.uniform("footprintSample"), uint32_t(stats.emitterSampleCount));
-            glUniform2fv(emitterProgram.uniform("footprintPoint"), 1, &footprint.x);
             addVisibleLight(*this, emitterProgram, cube);
             ++stats.emitterSampleCount;
         }

@@ -36,7 +36,6 @@ uniform bool emitterDoubleSided;
 uniform vec3 samplePoint;
 uniform int page;
 uniform uint footprintSample;              // this emitter sample's index over all emitters
-uniform vec2 footprintPoint;               // its point of every texel's square, in [0, 1)^2 (bakeEmitters)
 
 void main() {
     vec3 positionDx = dFdx(vPosition), positionDy = dFdy(vPosition);
@@ -44,7 +43,7 @@ void main() {
     vec3 baryDx = dFdx(vBary), baryDy = dFdy(vBary);
     if (gl_HelperInvocation) return;
     ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), page);
-    vec2 jitter = onChartOffset(footprintPoint, vBary, baryDx, baryDy, vFlags, footprintSample);
+    vec2 jitter = footprintOffset(vBary, baryDx, baryDy, vFlags, footprintSample);
     vec3 n = normalize(vNormal + normalDx * jitter.x + normalDy * jitter.y);
     vec3 x = vPosition + positionDx * jitter.x + positionDy * jitter.y;
     vec3 toX = x - samplePoint;

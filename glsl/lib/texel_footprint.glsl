@@ -28,25 +28,17 @@ bool offChart(vec3 bary, vec3 baryDx, vec3 baryDy, uint flags, vec2 offset) {
            ((borders & 4u) != 0u && b.z < 0.0);
 }
 
-// Offset in texels of the footprint point `first` (each coordinate in [0, 1)
-// over the texel's square) where it lies on the chart, else of another: the
-// candidates off the chart are replaced by ones hashed from `sampleIndex`;
-// each coordinate of the result in [-0.5, 0.5).
-vec2 onChartOffset(vec2 first, vec3 bary, vec3 baryDx, vec3 baryDy, uint flags, uint sampleIndex) {
-    vec2 offset = first - 0.5;
+// Offset in texels of sample `sampleIndex`'s point, each coordinate in [-0.5, 0.5).
+vec2 footprintOffset(vec3 bary, vec3 baryDx, vec3 baryDy, uint flags, uint sampleIndex) {
+    // R2 in 32-bit fixed point (alpha * 2^32, wrapping: exact for any index), from 0.5
+    uvec2 fixedPoint = uvec2(sampleIndex * 3242174889u, sampleIndex * 2447445413u) + 0x80000000u;
+    vec2 offset = vec2(fixedPoint >> 8u) * (1.0 / 16777216.0) - 0.5;
     for (int attempt = 0; attempt < 8; ++attempt) {
         if (!offChart(bary, baryDx, baryDy, flags, offset)) return offset;
         uint h = pcgHash(sampleIndex * 8u + uint(attempt));
         offset = vec2(uniform01(h), uniform01(pcgHash(h))) - 0.5;
     }
     return vec2(0.0);
-}
-
-// Offset in texels of sample `sampleIndex`'s point, each coordinate in [-0.5, 0.5).
-vec2 footprintOffset(vec3 bary, vec3 baryDx, vec3 baryDy, uint flags, uint sampleIndex) {
-    // R2 in 32-bit fixed point (alpha * 2^32, wrapping: exact for any index), from 0.5
-    uvec2 fixedPoint = uvec2(sampleIndex * 3242174889u, sampleIndex * 2447445413u) + 0x80000000u;
-    return onChartOffset(vec2(fixedPoint >> 8u) * (1.0 / 16777216.0), bary, baryDx, baryDy, flags, sampleIndex);
 }
 
 // Barycentrics as a vertex output: vertex k of a (non-indexed) triangle is e_k.

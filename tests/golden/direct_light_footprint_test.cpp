@@ -106,16 +106,14 @@ TEST(DirectLightFootprint, CornellDirectLightMatchesReferenceInPenumbrae) {
 
 // More emitter samples bring the direct light closer to the reference, with
 // no floor at the 1 % of 128 samples. Each sample reads one point of every
-// texel's footprint and one point of the light. Both from the R2 sequence and
-// taken in the same order, the two points are tied (their offsets differ by a
-// constant): a penumbra crossing the footprint is read at one pairing only,
+// texel's footprint and one point of the light, both from the R2 sequence:
+// taken in the same order the two points are tied (their offsets differ by a
+// constant), a penumbra crossing the footprint is read at one pairing only,
 // and the error stayed at 1.09 / 1.17 % with 512 / 1024 samples. Paired at
 // random (and each sample's cube map turned at random): 0.59 % at 512, 0.39 %
 // at 2048 on 512^2 cube faces (`bundlebake reference` at 65536 spp, its own
-// noise 0.03 %). Both points from one 4D sequence (R4): 0.41 % at 2048 on the
-// 268^2 faces the box now takes, against 0.44 % paired at random (three seeds
-// each). Here 1024 samples (0.47 %, 0.55 % paired at random) against 16384
-// spp (noise about 0.06 %); tolerance 0.8 %.
+// noise 0.03 %). Here 1024 samples on the 268^2 faces the box now takes
+// (0.55 %), against 16384 spp (noise about 0.06 %); tolerance 0.8 %.
 TEST(DirectLightFootprint, MoreEmitterSamplesKeepLoweringTheError) {
     BB_REQUIRE_GL();
     const auto b = bakeBlackCornellBox(1024, 16384);
