@@ -294,7 +294,10 @@ void Baker::Impl::coveragePass() {
     for (int p = 0; p < layout.pageCount; ++p) {
         gl::readTexture(dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, codes.data());
         stats.coveredTexels += std::count(codes.begin(), codes.end(), uint8_t(DILATION_SELF));
-        chartNeighbourBits(codes, texelOwners(mesh, p, res), chart, res, neighbours);
+        const std::vector<int32_t> owners = texelOwners(mesh, p, res);
+        chartNeighbourBits(codes, owners, chart, res, neighbours);
+        const std::vector<uint64_t> masks = footprintMasks(mesh, p, res, owners, chart);
+        gl::writeTexture(footprintCells.id(), 0, 0, p, res, res, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, masks.data());
         gl::writeTexture(chartNeighbours.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1,
                          neighbours.data());
         dilationCodes(codes, res, radius);
@@ -472,13 +475,15 @@ Status Baker::Impl::init(const Scene& scene) {
         direct = gl::Texture::create2DArray("direct light (fp16)", GL_RGBA16F, res, res, pages);
         dilation = gl::Texture::create2DArray("dilation codes", GL_R8UI, res, res, pages);
         chartNeighbours = gl::Texture::create2DArray("same-chart neighbours", GL_R8UI, res, res, pages);
+        footprintCells = gl::Texture::create2DArray("footprint cells on the chart", GL_RG32UI, res, res, pages);
         readModes = gl::Texture::create2DArray("radiance read modes", GL_R8UI, res, res, stateLayers());
         accumAsFloat = gl::Texture::createView("accumulators as rg32f (direct light sums)", accum, GL_RG32F);
         radianceBits = gl::Texture::createView("outgoing radiance as r32ui", radiance, GL_R32UI);
         radianceAsFloat = gl::Texture::createView("outgoing radiance as r32f (direct light sums)", radiance, GL_R32F);
     }
     stats.lightmapStateBytes =
-        accum.bytes() + radiance.bytes() + direct.bytes() + dilation.bytes() + chartNeighbours.bytes() + readModes.bytes();
+        accum.bytes() + radiance.bytes() + direct.bytes() + dilation.bytes() + chartNeighbours.bytes() + readModes.bytes() +
+        footprintCells.bytes();
     {
         // the noise estimate's half: about 256^2 sampled texels a page, every texel of small pages
         MemoryCategory category("noise estimate");

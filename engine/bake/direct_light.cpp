@@ -36,7 +36,7 @@ struct DistanceCube {
     glm::mat3 cubeFromWorld{1.0f};
 
     DistanceCube(int faceSize, GLuint triangleBuffer, int64_t triangles) : size(faceSize) {
-        cube = gl::Texture::createCube("shadow cube distances", GL_R32F, size);
+        cube = gl::Texture::createCube("shadow cube distances and planes", GL_RGBA32F, size);
         glTextureParameteri(cube.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
         glTextureParameteri(cube.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
         depth = gl::Texture::create2D("shadow cube depth", GL_DEPTH_COMPONENT32F, size, size);
@@ -55,7 +55,7 @@ struct DistanceCube {
         static const glm::vec3 faceDir[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
         static const glm::vec3 faceUp[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
         const glm::mat4 projection = glm::perspective(glm::radians(90.0f), 1.0f, nearPlane, farPlane);
-        const float farValue = 1e30f;
+        const float farValue[4] = {1e30f, 0.0f, 0.0f, 0.0f};
         glBindVertexArray(vertexArray);
         glUseProgram(program.id());
         glUniform3fv(program.uniform("samplePoint"), 1, &point.x);
@@ -66,7 +66,7 @@ struct DistanceCube {
             glNamedFramebufferTextureLayer(fbo.id(), GL_COLOR_ATTACHMENT0, cube.id(), 0, f);
             glm::mat4 clipFromWorld = projection * glm::lookAt(glm::vec3(0.0f), faceDir[f], faceUp[f]) * cubeFromPoint;
             glUniformMatrix4fv(program.uniform("clipFromWorld"), 1, GL_FALSE, &clipFromWorld[0][0]);
-            glClearNamedFramebufferfv(fbo.id(), GL_COLOR, 0, &farValue);
+            glClearNamedFramebufferfv(fbo.id(), GL_COLOR, 0, farValue);
             glClearNamedFramebufferfi(fbo.id(), GL_DEPTH_STENCIL, 0, 1.0f, 0);
             chunks.drawArrays(program.id(), 0, chunks.triangleCount());
         }
@@ -101,6 +101,7 @@ void Baker::Impl::bakeSun() {
             glUniform3fv(sunProgram.uniform("sunIrradiance"), 1, &irradiance.x);
             glUniform1f(sunProgram.uniform("depthBias"), depthBias);
             glUniform1ui(sunProgram.uniform("footprintSample"), footprintSample);
+            glBindTextureUnit(BINDING_FOOTPRINT_CELLS, footprintCells.id());
             bindDirectSums(*this);
             glBindImageTexture(BINDING_DIRECT, direct.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA16F);
             return sunProgram.id();
@@ -206,6 +207,7 @@ void Baker::Impl::bakeEmitters() {
     const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     glClearTexImage(sums.id(), 0, GL_RGBA, GL_FLOAT, zero);
     glBindImageTexture(BINDING_EMITTER_SUMS, sums.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindTextureUnit(BINDING_FOOTPRINT_CELLS, footprintCells.id());
 
     for (const Emitter& e : emitters) {
         const BakeVertex* v = &mesh.vertices[e.triangle * 3];
@@ -266,12 +268,17 @@ void Baker::Impl::bakePunctualLights() {
     MemoryCategory category("direct light");
     DistanceCube cube(shadowCubeSize(*this), triangleBuffer.id(), int64_t(mesh.triangles.size()));
     bindAlphaMasks();
-    for (const PunctualLight& light : punctualLights) {
+    for (size_t li = 0; li < punctualLights.size(); ++li) {
+        const PunctualLight& light = punctualLights[li];
         const glm::vec3 position(light.position - mesh.origin);  // local space, as the mesh
         // every surface lies within |position - centre| + radius of the light
         const float reach = glm::length(position - sphereCenter) + sphereRadius;
         const float nearPlane = 1e-4f * sphereRadius, farPlane = 1.01f * reach + sphereRadius;
-        cube.render(vao.id(), distanceProgram, position, glm::mat3(1.0f), nearPlane, farPlane);
+        // turned at random, as the emitter samples' cubes: with the faces along
+        // the axes, a floor texel seen exactly along a face's diagonal (the light
+        // at a whole number of texels from it) read another face's distance
+        const glm::mat3 orientation(randomRotation(hash(options.seed, li, 0x70756e6374ull)));
+        cube.render(vao.id(), distanceProgram, position, orientation, nearPlane, farPlane);
 
         const glm::vec3 intensity = light.intensity / radianceUnit;
         const float cosOuter = std::cos(light.outerConeAngle), cosInner = std::cos(light.innerConeAngle);

@@ -48,6 +48,7 @@ void Baker::Impl::beginDirection(int k) {
         glBindImageTexture(BINDING_HALF_ACCUM, halfAccum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
         glUniform1f(updateProgram.uniform("depthBias"), depthBias);
         glUniform1ui(updateProgram.uniform("footprintSample"), uint32_t(k));
+        glBindTextureUnit(BINDING_FOOTPRINT_CELLS, footprintCells.id());
         if (useEnv) glBindTextureUnit(BINDING_ENV, envTexture.id());
         glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
         return updateProgram.id();

@@ -129,6 +129,59 @@ std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res) {
     return owner;
 }
 
+std::vector<uint64_t> footprintMasks(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,
+                                     const std::vector<uint32_t>& chart) {
+    std::vector<uint64_t> mask(size_t(res) * res, 0);
+    auto chartAt = [&](int x, int y) -> int64_t {
+        if (x < 0 || y < 0 || x >= res || y >= res) return -1;
+        const int32_t o = owner[size_t(y) * res + x];
+        return o < 0 ? -1 : int64_t(chart[size_t(o)]);
+    };
+    // texels whose whole square is on their chart need no cells
+    std::vector<uint8_t> border(mask.size(), 0);
+    for (int y = 0; y < res; ++y)
+        for (int x = 0; x < res; ++x) {
+            const int64_t c = chartAt(x, y);
+            if (c < 0) continue;
+            bool inner = true;
+            for (int dy = -1; dy <= 1 && inner; ++dy)
+                for (int dx = -1; dx <= 1 && inner; ++dx) inner = chartAt(x + dx, y + dy) == c;
+            if (inner) mask[size_t(y) * res + x] = ~uint64_t(0);
+            else border[size_t(y) * res + x] = 1;
+        }
+    static const glm::dvec2 probes[5] = {{0.5, 0.5}, {0.1, 0.1}, {0.9, 0.1}, {0.1, 0.9}, {0.9, 0.9}};
+    for (uint32_t t = mesh.pageFirstTriangle[size_t(page)]; t < mesh.pageFirstTriangle[size_t(page) + 1]; ++t) {
+        glm::dvec2 q[3];
+        const double absArea = pageCorners(mesh, t, res, q);
+        if (absArea == 0.0 || !std::isfinite(absArea)) continue;
+        auto inside = [&](const glm::dvec2& c) {
+            for (int e = 0; e < 3; ++e) {
+                const glm::dvec2 a = q[(e + 1) % 3], b = q[(e + 2) % 3];
+                if ((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x) < 0.0) return false;
+            }
+            return true;
+        };
+        const int x0 = std::max(0, int(std::floor(std::min({q[0].x, q[1].x, q[2].x}))));
+        const int x1 = std::min(res - 1, int(std::floor(std::max({q[0].x, q[1].x, q[2].x}))));
+        const int y0 = std::max(0, int(std::floor(std::min({q[0].y, q[1].y, q[2].y}))));
+        const int y1 = std::min(res - 1, int(std::floor(std::max({q[0].y, q[1].y, q[2].y}))));
+        for (int y = y0; y <= y1; ++y)
+            for (int x = x0; x <= x1; ++x) {
+                const size_t i = size_t(y) * res + x;
+                if (!border[i] || chartAt(x, y) != int64_t(chart[t])) continue;
+                for (int cell = 0; cell < 64; ++cell) {
+                    if (mask[i] & (uint64_t(1) << cell)) continue;
+                    for (const glm::dvec2& p : probes)
+                        if (inside(glm::dvec2(x + (cell % 8 + p.x) / 8.0, y + (cell / 8 + p.y) / 8.0))) {
+                            mask[i] |= uint64_t(1) << cell;
+                            break;
+                        }
+                }
+            }
+    }
+    return mask;
+}
+
 BakeMesh buildBakeMesh(const Scene& scene, const Layout& layout) {
     CHECK_EQ(layout.rects.size(), scene.instances.size());
     const size_t pageCount = size_t(layout.pageCount);

@@ -75,4 +75,13 @@ double pageCorners(const BakeMesh& mesh, uint32_t t, int res, glm::dvec2 (&q)[3]
 // still differ).
 std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res);
 
+// Which parts of each texel's square lie on its chart (the chart of its owner,
+// texelOwners): bit 8 j + i for the cell [i/8, (i+1)/8) x [j/8, (j+1)/8) of the
+// square, set where the cell touches one of the chart's triangles (its centre
+// or a corner inset by 1/10 of the cell). A footprint point in a cell whose
+// bit is clear is off the chart (lib/texel_footprint.glsl). Texels whose eight
+// neighbours are all on their chart: every bit; uncovered texels: none.
+std::vector<uint64_t> footprintMasks(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,
+                                     const std::vector<uint32_t>& chart);
+
 }  // namespace bb

@@ -9,8 +9,20 @@ in vec2 vUv0;
 flat in uint vMaterial;
 flat in uint vFlags;
 uniform vec3 samplePoint;
-layout(location = 0) out float outDistance;
+// the distance's bits and the surface's plane normal (either way), octahedral
+// as two snorm16 (lib/cube_visibility.glsl)
+layout(location = 0) out vec4 outDistance;
+
+vec2 octahedralEncode(vec3 n) {
+    n /= abs(n.x) + abs(n.y) + abs(n.z);
+    if (n.z < 0.0) n.xy = (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
+    return n.xy;
+}
+
 void main() {
+    vec3 facet = cross(dFdx(vPosition), dFdy(vPosition));
     if ((vFlags & TRIANGLE_ALPHA_MASK) != 0u && alphaCut(vMaterial, vUv0)) discard;
-    outDistance = distance(vPosition, samplePoint);
+    // a degenerate facet: a plane facing the light point, as good as the receiver's test alone
+    vec3 n = length(facet) > 0.0 ? facet : vPosition - samplePoint;
+    outDistance = vec4(distance(vPosition, samplePoint), normalize(n));
 }

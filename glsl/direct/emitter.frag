@@ -36,6 +36,7 @@ uniform bool emitterDoubleSided;
 uniform vec3 samplePoint;
 uniform int page;
 uniform uint footprintSample;              // this emitter sample's index over all emitters
+layout(binding = BINDING_FOOTPRINT_CELLS) uniform usampler2DArray footprintCells;
 
 void main() {
     vec3 positionDx = dFdx(vPosition), positionDy = dFdy(vPosition);
@@ -43,7 +44,7 @@ void main() {
     vec3 baryDx = dFdx(vBary), baryDy = dFdy(vBary);
     if (gl_HelperInvocation) return;
     ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), page);
-    vec2 jitter = footprintOffset(vBary, baryDx, baryDy, vFlags, footprintSample);
+    vec2 jitter = footprintOffset(vBary, baryDx, baryDy, vFlags, texelFetch(footprintCells, texel, 0).rg, footprintSample);
     vec3 n = normalize(vNormal + normalDx * jitter.x + normalDy * jitter.y);
     vec3 x = vPosition + positionDx * jitter.x + positionDy * jitter.y;
     vec3 toX = x - samplePoint;

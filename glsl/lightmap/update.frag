@@ -58,6 +58,7 @@ uniform int backLayerOffset;  // BACK_SIDES: double-sided triangles' back sides'
 uniform uint nodeCount;      // nodes in this tile's lists (END_OF_LIST is larger)
 uniform float depthBias;      // scene units: float precision floor
 uniform uint footprintSample; // this pass's sample of each texel's footprint (the direction's, the sun jitter's index)
+layout(binding = BINDING_FOOTPRINT_CELLS) uniform usampler2DArray footprintCells;
 
 const float PI = 3.14159265358979;
 
@@ -195,7 +196,7 @@ float ownCrossing(OwnSurface own, ivec2 pixel, vec2 offset) {
 // (a grazing direction) or more than 6 x 6 might (a leaf much finer than the
 // texel, where the blur is small), false: the footprint's own point instead.
 bool footprintPixel(vec2 centre, vec3 positionDx, vec3 positionDy, vec3 bary, vec3 baryDx, vec3 baryDy, uint flags,
-                    uint seed, out vec2 offset) {
+                    uvec2 cells, uint seed, out vec2 offset) {
     // columns: pixels per texel of offset along the light map's x and y
     mat2 G = mat2(vec2(dot(positionDx, bundleU), dot(positionDx, bundleV)),
                   vec2(dot(positionDy, bundleU), dot(positionDy, bundleV))) / pixelSize;
@@ -210,7 +211,7 @@ bool footprintPixel(vec2 centre, vec3 positionDx, vec3 positionDy, vec3 bary, ve
     for (int y = lo.y; y <= hi.y; ++y)
         for (int x = lo.x; x <= hi.x; ++x) {
             vec2 o = offsetFromPixel * (vec2(x, y) + 0.5 - centre);
-            if (any(greaterThan(abs(o), vec2(0.5))) || offChart(bary, baryDx, baryDy, flags, o)) continue;
+            if (any(greaterThan(abs(o), vec2(0.5))) || offChart(bary, baryDx, baryDy, flags, cells, o)) continue;
             uint h = pcgHash(seed ^ (uint(x) * 0x9e3779b1u) ^ (uint(y) * 0x85ebca77u));
             if (!found || h > best) {
                 best = h;
@@ -247,8 +248,9 @@ void main() {
     uint pixelSeed = pcgHash(randomSeed);
 #endif
     vec2 jitter;
-    if (!footprintPixel(gridFromRoot(centreRoot), positionDx, positionDy, vBary, baryDx, baryDy, vFlags, pixelSeed, jitter)) {
-        jitter = footprintOffset(vBary, baryDx, baryDy, vFlags, footprintSample);
+    uvec2 cells = texelFetch(footprintCells, texel, 0).rg;
+    if (!footprintPixel(gridFromRoot(centreRoot), positionDx, positionDy, vBary, baryDx, baryDy, vFlags, cells, pixelSeed, jitter)) {
+        jitter = footprintOffset(vBary, baryDx, baryDy, vFlags, cells, footprintSample);
 #ifdef SUN_PASS
         // The sun's sample is where its pixel's ray meets the surface: the pixel
         // (jittered from run to run, bakeSun) spreads it too, by up to half a

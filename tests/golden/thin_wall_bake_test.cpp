@@ -124,6 +124,44 @@ void checkSealedRoomStaysDark(int bundleResolution, int directions,
 }
 
 TEST(ThinWallBake, SealedRoomBehindOneTexelWallStaysDark) { checkSealedRoomStaysDark(0, 128); }
+
+// The explicit emitter's direct light alone (every albedo 0) through the same
+// slab at the asset atlas's 64^2 (14 cm texels: the slab is a seventh of a
+// texel and of a bundle pixel): room B must stay exactly dark. The shadow
+// cube maps compared distances within half a bundle pixel (3.5 cm here), so
+// the texels of room B within a few centimetres of the slab saw room A's
+// panel through it: up to 4 % of room A's mean on room B's floor. Tolerance:
+// 1e-4 x room A's mean (0 exactly but for fp16 rounding of zero sums, which
+// is exact).
+TEST(ThinWallBake, NoDirectLightThroughASlabThinnerThanABundlePixel) {
+    BB_REQUIRE_GL();
+    BakeOptions options;
+    options.directions = 16;
+    SceneBake bake = makeBake("assets/two_rooms/two_rooms.gltf", assetLayout(64), options, [](Scene& scene) {
+        for (Material& m : scene.materials) {
+            m.albedo = glm::vec3(0.0f);
+            m.albedoTexture = -1;
+        }
+    });
+    ASSERT_TRUE(bake) << bake.error;
+    bakeToEnd(*bake.baker);
+    const LightmapPages maps = bake.baker->readLightmaps();
+    const BakeMesh& mesh = bake.baker->mesh();
+    const std::vector<int> owner = texelTriangles(mesh, maps.resolution);
+    Summary roomA, roomB;
+    for (size_t i = 0; i < owner.size(); ++i) {
+        if (!maps.covered[0][i] || owner[i] < 0) continue;
+        const auto v = maps.pages[0].pixels[i];
+        (triangleCentroid(mesh, owner[i]).x > 0.0f ? roomB : roomA).add(std::max({v.r, v.g, v.b}), i);
+    }
+    roomA.finish();
+    roomB.finish();
+    std::printf("[thin slab, direct light] room A: %s; room B: %s\n", describe(roomA, maps.resolution).c_str(),
+                describe(roomB, maps.resolution).c_str());
+    ASSERT_GT(roomB.count, 500u);
+    ASSERT_GT(roomA.mean, 0.01);
+    EXPECT_LT(roomB.max, 1e-4 * roomA.mean) << describe(roomB, maps.resolution);
+}
 TEST(ThinWallBake, UniformTilingSealedRoomStaysDark) { checkSealedRoomStaysDark(0, 128, BakeOptions::Tiling::Uniform); }
 
 }  // namespace
