@@ -36,7 +36,7 @@ struct DistanceCube {
     glm::mat3 cubeFromWorld{1.0f};
 
     DistanceCube(int faceSize, GLuint triangleBuffer, int64_t triangles) : size(faceSize) {
-        cube = gl::Texture::createCube("shadow cube distances and planes", GL_RGBA32F, size);
+        cube = gl::Texture::createCube("shadow cube distances and planes", GL_RG32UI, size);
         glTextureParameteri(cube.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
         glTextureParameteri(cube.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
         depth = gl::Texture::create2D("shadow cube depth", GL_DEPTH_COMPONENT32F, size, size);
@@ -55,7 +55,9 @@ struct DistanceCube {
         static const glm::vec3 faceDir[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
         static const glm::vec3 faceUp[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
         const glm::mat4 projection = glm::perspective(glm::radians(90.0f), 1.0f, nearPlane, farPlane);
-        const float farValue[4] = {1e30f, 0.0f, 0.0f, 0.0f};
+        const float far = 1e30f;
+        GLuint farValue[4] = {0u, 0u, 0u, 0u};  // (1e30's bits, a normal along +z)
+        std::memcpy(&farValue[0], &far, 4);
         glBindVertexArray(vertexArray);
         glUseProgram(program.id());
         glUniform3fv(program.uniform("samplePoint"), 1, &point.x);
@@ -66,7 +68,7 @@ struct DistanceCube {
             glNamedFramebufferTextureLayer(fbo.id(), GL_COLOR_ATTACHMENT0, cube.id(), 0, f);
             glm::mat4 clipFromWorld = projection * glm::lookAt(glm::vec3(0.0f), faceDir[f], faceUp[f]) * cubeFromPoint;
             glUniformMatrix4fv(program.uniform("clipFromWorld"), 1, GL_FALSE, &clipFromWorld[0][0]);
-            glClearNamedFramebufferfv(fbo.id(), GL_COLOR, 0, farValue);
+            glClearNamedFramebufferuiv(fbo.id(), GL_COLOR, 0, farValue);
             glClearNamedFramebufferfi(fbo.id(), GL_DEPTH_STENCIL, 0, 1.0f, 0);
             chunks.drawArrays(program.id(), 0, chunks.triangleCount());
         }

@@ -11,7 +11,7 @@ flat in uint vFlags;
 uniform vec3 samplePoint;
 // the distance's bits and the surface's plane normal (either way), octahedral
 // as two snorm16 (lib/cube_visibility.glsl)
-layout(location = 0) out vec4 outDistance;
+layout(location = 0) out uvec2 outDistance;
 
 vec2 octahedralEncode(vec3 n) {
     n /= abs(n.x) + abs(n.y) + abs(n.z);
@@ -24,5 +24,5 @@ void main() {
     if ((vFlags & TRIANGLE_ALPHA_MASK) != 0u && alphaCut(vMaterial, vUv0)) discard;
     // a degenerate facet: a plane facing the light point, as good as the receiver's test alone
     vec3 n = length(facet) > 0.0 ? facet : vPosition - samplePoint;
-    outDistance = vec4(distance(vPosition, samplePoint), normalize(n));
+    outDistance = uvec2(floatBitsToUint(distance(vPosition, samplePoint)), packSnorm2x16(octahedralEncode(n)));
 }

@@ -22,7 +22,7 @@
 // the direct light through a 2 cm slab onto the texels of the room behind it
 // that lie within a few centimetres of the slab (two rooms at 64^2, 14 cm
 // texels: 4 % of the lit room's floor on the sealed room's floor beside it).
-layout(binding = 0) uniform samplerCube distances;  // (distance, octahedral plane normal as 2 x snorm16 in a float's bits)
+layout(binding = 0) uniform usamplerCube distances;  // (distance's bits, octahedral plane normal as 2 x snorm16)
 uniform float rayOffset;  // scene units: half a bundle pixel
 uniform int cubeSize;     // texels per face side
 uniform mat3 cubeFromWorld;  // the cube's orientation (a rotation; emitter samples turn theirs at random)
@@ -51,8 +51,8 @@ bool occludedFromLight(vec3 x, vec3 planeNormal, vec3 lightPoint) {
     vec3 fromLight = x - lightPoint;
     float dist = length(fromLight);
     vec3 inCube = cubeFromWorld * fromLight;
-    vec4 texel4 = texture(distances, inCube);
-    float stored = texel4.r;
+    uvec2 texel = texture(distances, inCube).rg;
+    float stored = uintBitsToFloat(texel.r);
     vec3 centreRay = transpose(cubeFromWorld) * cubeTexelCentre(inCube);
     float tolerance = 0.05 * rayOffset + 1e-5 * dist;
     // where the centre ray meets x's plane: x's own surface along that ray
@@ -70,7 +70,7 @@ bool occludedFromLight(vec3 x, vec3 planeNormal, vec3 lightPoint) {
     // sees within 6 degrees of edge-on gives no precise crossing (mostly the
     // receiver's own surface, at a grazing light): the receiver's test then,
     // with the tolerance of half a bundle pixel
-    vec3 occluderNormal = normalize(texel4.gba);
+    vec3 occluderNormal = octahedralDecode(unpackSnorm2x16(texel.g));
     float across = dot(occluderNormal, fromLight) / dist;
     if (abs(across) < 0.1) return stored < receiver - rayOffset;
     float t = dot(occluderNormal, centreRay * stored) / across;
