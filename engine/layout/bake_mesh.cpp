@@ -138,7 +138,6 @@ std::vector<uint64_t> footprintMasks(const BakeMesh& mesh, int page, int res, co
         return o < 0 ? -1 : int64_t(chart[size_t(o)]);
     };
     // texels whose whole square is on their chart need no cells
-    std::vector<uint8_t> border(mask.size(), 0);
     for (int y = 0; y < res; ++y)
         for (int x = 0; x < res; ++x) {
             const int64_t c = chartAt(x, y);
@@ -147,7 +146,6 @@ std::vector<uint64_t> footprintMasks(const BakeMesh& mesh, int page, int res, co
             for (int dy = -1; dy <= 1 && inner; ++dy)
                 for (int dx = -1; dx <= 1 && inner; ++dx) inner = chartAt(x + dx, y + dy) == c;
             if (inner) mask[size_t(y) * res + x] = ~uint64_t(0);
-            else border[size_t(y) * res + x] = 1;
         }
     static const glm::dvec2 probes[5] = {{0.5, 0.5}, {0.1, 0.1}, {0.9, 0.1}, {0.1, 0.9}, {0.9, 0.9}};
     for (uint32_t t = mesh.pageFirstTriangle[size_t(page)]; t < mesh.pageFirstTriangle[size_t(page) + 1]; ++t) {
@@ -168,7 +166,7 @@ std::vector<uint64_t> footprintMasks(const BakeMesh& mesh, int page, int res, co
         for (int y = y0; y <= y1; ++y)
             for (int x = x0; x <= x1; ++x) {
                 const size_t i = size_t(y) * res + x;
-                if (!border[i] || chartAt(x, y) != int64_t(chart[t])) continue;
+                if (mask[i] == ~uint64_t(0) || chartAt(x, y) != int64_t(chart[t])) continue;
                 for (int cell = 0; cell < 64; ++cell) {
                     if (mask[i] & (uint64_t(1) << cell)) continue;
                     for (const glm::dvec2& p : probes)
