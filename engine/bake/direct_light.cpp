@@ -46,10 +46,11 @@ struct DistanceCube {
         chunks = MeshChunks::create(triangles, {{MESH_BINDING_TRIANGLES, triangleBuffer, int64_t(sizeof(BakeTriangle))}});
     }
 
-    // Draws the whole mesh into the six faces around `point`, turned by
-    // `orientation` (cube from world), distances up to farPlane.
+    // Draws the whole mesh but triangle `own` (an emitter sample's) into the
+    // six faces around `point`, turned by `orientation` (cube from world),
+    // distances up to farPlane.
     void render(GLuint vertexArray, const gl::Program& program, const glm::vec3& point, const glm::mat3& orientation,
-                float nearPlane, float farPlane) {
+                float nearPlane, float farPlane, uint32_t own = 0xffffffffu) {
         cubeFromWorld = orientation;
         const glm::mat4 cubeFromPoint = glm::mat4(orientation) * glm::translate(glm::mat4(1.0f), -point);
         static const glm::vec3 faceDir[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
@@ -61,6 +62,7 @@ struct DistanceCube {
         glBindVertexArray(vertexArray);
         glUseProgram(program.id());
         glUniform3fv(program.uniform("samplePoint"), 1, &point.x);
+        glUniform1ui(program.uniform("ownTriangle"), own);
         glEnable(GL_DEPTH_TEST);
         glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
         glViewport(0, 0, size, size);
@@ -238,7 +240,7 @@ void Baker::Impl::bakeEmitters() {
             glm::vec3 point = a + float(su) * (b - a) + float(sv) * (c - a) + n * (1e-4f * pixelSize);
             // distance cube map
             const glm::mat3 orientation(randomRotation(hash(options.seed, e.triangle, uint64_t(i) + (1ull << 32))));
-            cube.render(vao.id(), distanceProgram, point, orientation, nearPlane, farPlane);
+            cube.render(vao.id(), distanceProgram, point, orientation, nearPlane, farPlane, uint32_t(e.triangle));
             // accumulate this sample's share into the direct map, page by page
             glUseProgram(emitterProgram.id());
             glUniform3fv(emitterProgram.uniform("emitterA"), 1, &a.x);

@@ -7,10 +7,12 @@ out vec3 vPosition;
 out vec2 vUv0;
 flat out uint vMaterial;
 flat out uint vFlags;
+flat out uint vTriangle;
 void main() {
     vPosition = inPosition.xyz;
     vUv0 = inUv0;
-    uvec4 tri = bakeTriangle(uint(gl_VertexID) / 3u);
+    vTriangle = uint(gl_VertexID) / 3u;
+    uvec4 tri = bakeTriangle(vTriangle);
     vMaterial = tri.x;
     vFlags = tri.w;
     gl_Position = clipFromWorld * vec4(inPosition.xyz, 1.0);
