@@ -19,6 +19,7 @@
 #include <cmath>
 #include <cstdio>
 #include <optional>
+#include <vector>
 
 #include "layout/layout.h"
 #include "reference/reference_baker.h"
@@ -149,6 +150,76 @@ TEST(DirectLightFootprint, FanTriangulatedFloorsCornersMatchTheReference) {
         ASSERT_GT(ref, 0.01);
         EXPECT_NEAR(baked, ref, 0.02 * ref) << texelName(i, res);
     }
+}
+
+// Lambert's polygon form factor from a point with normal n (the light at
+// the point from a uniform emitter of radiance 1, as L_lm).
+double polygonFormFactor(const glm::dvec3& x, const glm::dvec3& n, const std::vector<glm::dvec3>& polygon) {
+    double sum = 0.0;
+    for (size_t i = 0; i < polygon.size(); ++i) {
+        const glm::dvec3 a = glm::normalize(polygon[i] - x), b = glm::normalize(polygon[(i + 1) % polygon.size()] - x);
+        sum += std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0)) * glm::dot(glm::normalize(glm::cross(a, b)), n);
+    }
+    return std::fabs(sum) / (2.0 * M_PI);
+}
+
+// A ceiling a sixteenth of a texel over a smaller emitter (Le 1, facing it;
+// every albedo 0), as the shared Cornell box's ceiling is 0.9 mm over its
+// light: along the emitter's outline the form factor F steps from 1 to 0
+// within a texel, and the texels there hold the share of their footprint
+// over the emitter. Against F's footprint mean, integrated here on a 64 x 64
+// grid, at 128 samples (64 a triangle). Before: the outline texels' mean
+// +1.9 %, the worst 4.6 %, and inside up to 4.0 % dark: one footprint point a
+// sample read the step with the R2 points' error, and the light's points
+// that see the ceiling at a grazing angle read it as their own shadow. Now
+// (16 points a sample within a texel of the emitter's plane, the shallower
+// cube texel where the nearest one's ray meets the ceiling short of the
+// point): the mean within 0.01 %, the worst 0.6 %, inside 0.1 %. Tolerances:
+// each outline texel 1 %, their mean 0.3 %, inside 0.5 %.
+TEST(DirectLightFootprint, CeilingJustOverAnEmitterHoldsItsOutlinesShare) {
+    BB_REQUIRE_GL();
+    const double gap = 1.0 / 256.0, emitterHalf = 0.53;  // 16 texels a unit: the outline crosses texels at 48 %
+    Scene scene;
+    const int black = addMaterial(scene, glm::vec3(0.0f));
+    const int light = addMaterial(scene, glm::vec3(0.0f), glm::vec3(1.0f));
+    const int ceiling = addQuad(scene, glm::vec3(0.0f, float(gap), 0.0f), {1, 0, 0}, {0, 0, 1}, black, "ceiling");
+    const float e = float(emitterHalf);
+    addQuad(scene, glm::vec3(0.0f), {e, 0, 0}, {0, 0, -e}, light, "emitter");
+    auto layout = packLayout(scene, 64, 16.0f);
+    ASSERT_TRUE(layout) << layout.error();
+    BakeOptions options;
+    options.directions = 16;
+    options.emitterSamples = 128;
+    auto maps = bakeGpu(scene, *layout, options);
+    ASSERT_TRUE(maps) << maps.error();
+    const std::vector<glm::dvec3> emitter = {{-e, 0, -e}, {e, 0, -e}, {e, 0, e}, {-e, 0, e}};
+    const InstanceRect& r = layout->rects[size_t(ceiling)];
+    double outlineSum = 0.0, outlineExpected = 0.0, worst = 0.0, worstInside = 0.0;
+    int outline = 0, inside = 0;
+    forEachQuadTexel(scene, *layout, *maps, ceiling, [&](int page, size_t i, const glm::dvec3&, int a, int b) {
+        double f = 0.0;
+        for (int k = 0; k < 64 * 64; ++k) {
+            const glm::dvec3 p = quadPoint(scene, ceiling, (a + (k % 64 + 0.5) / 64) / r.width, (b + (k / 64 + 0.5) / 64) / r.height);
+            f += polygonFormFactor(p, {0, -1, 0}, emitter) / (64 * 64);
+        }
+        const double got = maps->pages[size_t(page)].pixels[i].g;
+        if (f > 0.05 && f < 0.95) {
+            EXPECT_NEAR(got / f, 1.0, 0.01) << "outline texel " << a << ", " << b << ": " << got << " against " << f;
+            outlineSum += got;
+            outlineExpected += f;
+            worst = std::max(worst, std::fabs(got / f - 1.0));
+            ++outline;
+        } else if (f >= 0.95) {
+            EXPECT_NEAR(got / f, 1.0, 0.005) << "texel " << a << ", " << b << ": " << got << " against " << f;
+            worstInside = std::max(worstInside, std::fabs(got / f - 1.0));
+            ++inside;
+        }
+    });
+    std::printf("[ceiling over an emitter] %d outline texels: mean %+.3f %%, worst %.3f %%; %d inside: worst %.3f %%\n", outline,
+                100 * (outlineSum / outlineExpected - 1), 100 * worst, inside, 100 * worstInside);
+    ASSERT_GE(outline, 60);
+    ASSERT_GE(inside, 200);
+    EXPECT_NEAR(outlineSum / outlineExpected, 1.0, 0.003);
 }
 
 }  // namespace
