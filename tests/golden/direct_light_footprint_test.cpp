@@ -152,17 +152,6 @@ TEST(DirectLightFootprint, FanTriangulatedFloorsCornersMatchTheReference) {
     }
 }
 
-// Lambert's polygon form factor from a point with normal n (the light at
-// the point from a uniform emitter of radiance 1, as L_lm).
-double polygonFormFactor(const glm::dvec3& x, const glm::dvec3& n, const std::vector<glm::dvec3>& polygon) {
-    double sum = 0.0;
-    for (size_t i = 0; i < polygon.size(); ++i) {
-        const glm::dvec3 a = glm::normalize(polygon[i] - x), b = glm::normalize(polygon[(i + 1) % polygon.size()] - x);
-        sum += std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0)) * glm::dot(glm::normalize(glm::cross(a, b)), n);
-    }
-    return std::fabs(sum) / (2.0 * M_PI);
-}
-
 // A ceiling a sixteenth of a texel over a smaller emitter (Le 1, facing it;
 // every albedo 0), as the shared Cornell box's ceiling is 0.9 mm over its
 // light: along the emitter's outline the form factor F steps from 1 to 0

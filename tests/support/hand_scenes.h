@@ -1,4 +1,4 @@
-// Scenes built by hand for the golden tests (no file): quads and boxes, each
+// Scenes built by hand for the tests (no file): quads and boxes, each
 // face its own instance with TEXCOORD_1 over [0,1]^2, for the `pack` layout
 // (every face gets its own rectangle). Object space = world space (identity
 // instance transforms), Scene::origin 0. Header-only, GL-free.
@@ -97,6 +97,17 @@ inline glm::dvec3 quadPoint(const Scene& scene, int instance, double s, double t
     const auto& p = scene.meshes[size_t(scene.instances[size_t(instance)].mesh)].primitives[0].positions;
     const glm::dvec3 p0(p[0]), p1(p[1]), p3(p[3]);
     return p0 + s * (p1 - p0) + t * (p3 - p0);
+}
+
+// Lambert's point-to-polygon form factor F from x with unit normal n: a
+// uniform emitter of radiance 1 gives x L_lm = F (closed-form checks).
+inline double polygonFormFactor(const glm::dvec3& x, const glm::dvec3& n, const std::vector<glm::dvec3>& polygon) {
+    double sum = 0.0;
+    for (size_t i = 0; i < polygon.size(); ++i) {
+        const glm::dvec3 a = glm::normalize(polygon[i] - x), b = glm::normalize(polygon[(i + 1) % polygon.size()] - x);
+        sum += std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0)) * glm::dot(glm::normalize(glm::cross(a, b)), n);
+    }
+    return std::fabs(sum) / (2.0 * M_PI);
 }
 
 // Visits every covered texel of a quad instance's pack rectangle: f(page,

@@ -22,6 +22,7 @@
 #include "layout/layout.h"
 #include "reference/reference_baker.h"
 #include "scene/scene.h"
+#include "support/hand_scenes.h"
 
 namespace bb {
 namespace {
@@ -397,88 +398,45 @@ TEST(ReferenceBaker, EnvironmentConvention) {
     }
 }
 
-// Lambert's polygon form factor from a point with normal n (the light at
-// the point from a uniform emitter of radiance 1, as L_lm).
-double polygonFormFactor(const glm::dvec3& x, const glm::dvec3& n, const std::vector<glm::dvec3>& polygon) {
-    double sum = 0.0;
-    for (size_t i = 0; i < polygon.size(); ++i) {
-        const glm::dvec3 a = glm::normalize(polygon[i] - x), b = glm::normalize(polygon[(i + 1) % polygon.size()] - x);
-        sum += std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0)) * glm::dot(glm::normalize(glm::cross(a, b)), n);
-    }
-    return std::fabs(sum) / (2.0 * M_PI);
-}
-
 // A ceiling 5 cm over an emitter four times as wide (Le 1, facing it; every
 // albedo 0): L_lm = the footprint's mean of the emitter's form factor F,
-// 0.9995 here on average. The emitter samples' shadow rays start off the ceiling
-// by the ray offset; aimed along the direction from the unshifted point, each
-// crossed the emitter's plane short of its sample and read the emitter as its
-// own blocker, leaving only the cosine samples' MIS share: the ceiling read
-// 2.4 % dark (the shared Cornell box's ceiling, 0.9 mm over its light:
-// 1.4 %). Tolerance: the mean 0.2 %, each texel 1 % (over four seeds at 1024
-// spp: the mean within 0.02 %, texels' rms 0.07 %, worst 0.25 %).
+// 0.9995 here on average. The emitter samples' shadow rays start off the
+// ceiling by the ray offset; aimed along the direction from the unshifted
+// point, each crossed the emitter's plane short of its sample and read the
+// emitter as its own blocker, leaving only the cosine samples' MIS share: the
+// ceiling read 2.4 % dark (the shared Cornell box's ceiling, 0.9 mm over its
+// light: 1.4 %). Tolerance: the mean 0.2 %, each texel 1 % (over four seeds
+// at 1024 spp: the mean within 0.02 %, texels' rms 0.07 %, worst 0.25 %).
 TEST(ReferenceBaker, CeilingJustOverAnEmitterSeesAllOfIt) {
-    Scene s;
-    auto quad = [&](float y, float half, const glm::vec3& normal, int material, const char* name) {
-        Primitive p;
-        const float side = normal.y > 0.0f ? 1.0f : -1.0f;  // counter-clockwise seen from the normal
-        p.positions = {{-half, y, -half * side}, {half, y, -half * side}, {half, y, half * side}, {-half, y, half * side}};
-        p.normals.assign(4, normal);
-        p.uv1 = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-        p.uv0 = p.uv1;
-        p.indices = {0, 2, 1, 0, 3, 2};
-        p.material = material;
-        Mesh m;
-        m.name = name;
-        m.primitives.push_back(p);
-        s.meshes.push_back(m);
-        Instance inst;
-        inst.name = name;
-        inst.mesh = int(s.meshes.size()) - 1;
-        inst.node = int(s.instances.size());
-        s.instances.push_back(inst);
-        for (const auto& x : p.positions) s.bounds.extend(x);
-    };
-    Material black, light;
-    black.albedo = light.albedo = glm::vec3(0.0f);
-    light.emission = glm::vec3(1.0f);
-    s.materials = {black, light};
-    const double gap = 0.05, half = 0.5, emitterHalf = 2.0;
-    quad(float(gap), float(half), glm::vec3(0, -1, 0), 0, "ceiling");
-    quad(0.0f, float(emitterHalf), glm::vec3(0, 1, 0), 1, "emitter");
-    LayoutOptions lo;
-    lo.mode = UvLayout::Pack;
-    lo.resolution = 64;
-    auto layout = computeLayout(s, lo);
+    Scene scene;
+    const int black = test::addMaterial(scene, glm::vec3(0.0f));
+    const int light = test::addMaterial(scene, glm::vec3(0.0f), glm::vec3(1.0f));
+    const float gap = 0.05f, e = 2.0f;
+    const int ceiling = test::addQuad(scene, {0.0f, gap, 0.0f}, {0.5f, 0, 0}, {0, 0, 0.5f}, black, "ceiling");
+    test::addQuad(scene, glm::vec3(0.0f), {e, 0, 0}, {0, 0, -e}, light, "emitter");
+    auto layout = test::packLayout(scene, 64, 10.0f);
     ASSERT_TRUE(layout) << layout.error();
     ReferenceOptions o;
     o.spp = 1024;
-    auto rb = ReferenceBaker::create(s, *layout, o);
-    ASSERT_TRUE(rb) << rb.error();
-    while (!(*rb)->step(1e9).done()) {
-    }
-    const LightmapPages maps = (*rb)->readLightmaps();
-    const InstanceRect& r = layout->rects[0];
-    const double e = emitterHalf;
+    auto maps = test::bakeReference(scene, *layout, o);
+    ASSERT_TRUE(maps) << maps.error();
     const std::vector<glm::dvec3> emitter = {{-e, 0, -e}, {e, 0, -e}, {e, 0, e}, {-e, 0, e}};
+    const InstanceRect& r = layout->rects[size_t(ceiling)];
     double sum = 0.0, expected = 0.0;
     int n = 0;
-    for (int b = 0; b < r.height; ++b)
-        for (int a = 0; a < r.width; ++a) {
-            const size_t i = size_t(r.y + b) * size_t(layout->resolution) + size_t(r.x + a);
-            ASSERT_TRUE(maps.covered[size_t(r.page)][i]);
-            // the footprint's mean of F, 8 x 8 points (TEXCOORD_1 u along x, v along -z)
-            double f = 0.0;
-            for (int k = 0; k < 64; ++k) {
-                const double u = (a + (k % 8 + 0.5) / 8.0) / r.width, v = (b + (k / 8 + 0.5) / 8.0) / r.height;
-                f += polygonFormFactor({(2.0 * u - 1.0) * half, gap, (1.0 - 2.0 * v) * half}, {0, -1, 0}, emitter) / 64.0;
-            }
-            const double got = maps.pages[size_t(r.page)].pixels[i].g;
-            EXPECT_NEAR(got / f, 1.0, 0.01) << "texel " << a << ", " << b << ": " << got << " against " << f;
-            sum += got;
-            expected += f;
-            ++n;
+    test::forEachQuadTexel(scene, *layout, *maps, ceiling, [&](int page, size_t i, const glm::dvec3&, int a, int b) {
+        // the footprint's mean of F, 8 x 8 points
+        double f = 0.0;
+        for (int k = 0; k < 64; ++k) {
+            const glm::dvec3 p = test::quadPoint(scene, ceiling, (a + (k % 8 + 0.5) / 8.0) / r.width, (b + (k / 8 + 0.5) / 8.0) / r.height);
+            f += test::polygonFormFactor(p, {0, -1, 0}, emitter) / 64.0;
         }
+        const double got = maps->pages[size_t(page)].pixels[i].g;
+        EXPECT_NEAR(got / f, 1.0, 0.01) << "texel " << a << ", " << b << ": " << got << " against " << f;
+        sum += got;
+        expected += f;
+        ++n;
+    });
     ASSERT_GE(n, 64);
     EXPECT_NEAR(sum / expected, 1.0, 0.002) << n << " texels, mean " << sum / n << " against " << expected / n;
 }
