@@ -39,6 +39,16 @@ uniform uint footprintSample;              // this emitter sample's index over a
 layout(binding = BINDING_FOOTPRINT_CELLS) uniform usampler2DArray footprintCells;
 const uint NEAR_FIELD_POINTS = 16u;  // F's points a sample within a texel of the emitter's plane
 
+// F from point p with normal n. Behind a single-sided emitter nothing
+// arrives, and a point in its plane (the emitter's own texels, a coplanar
+// ceiling) gets nothing either: Lambert's formula would give it the whole
+// hemisphere (F = 1) from inside the polygon.
+float formFactorAt(vec3 p, vec3 n) {
+    float facing = dot(emitterNormal, p - emitterA), planeEpsilon = 0.01 * rayOffset;
+    if (emitterDoubleSided ? abs(facing) <= planeEpsilon : facing <= planeEpsilon) return 0.0;
+    return polygonFormFactor(p, n, emitterA, emitterB, emitterC);
+}
+
 void main() {
     vec3 positionDx = dFdx(vPosition), positionDy = dFdy(vPosition);
     vec3 normalDx = dFdx(vNormal), normalDy = dFdy(vNormal);
@@ -49,15 +59,7 @@ void main() {
     vec2 jitter = footprintOffset(vBary, baryDx, baryDy, vFlags, cells, footprintSample);
     vec3 n = normalize(vNormal + normalDx * jitter.x + normalDy * jitter.y);
     vec3 x = vPosition + positionDx * jitter.x + positionDy * jitter.y;
-    // distance of x from the emitter's plane: behind a single-sided emitter
-    // nothing arrives, and a point in the plane (the emitter's own texels, a
-    // coplanar ceiling) gets nothing either: Lambert's formula would give it
-    // the whole hemisphere (F = 1) from inside the polygon
-    float planeEpsilon = 0.01 * rayOffset;
-    float facing = dot(emitterNormal, x - emitterA);
-    float f = 0.0;
-    if (!(emitterDoubleSided ? abs(facing) <= planeEpsilon : facing <= planeEpsilon))
-        f = polygonFormFactor(x, n, emitterA, emitterB, emitterC);
+    float f = formFactorAt(x, n);
     // F's mean over the footprint. Within a texel of the emitter's plane F
     // steps from 0 to 1 across the footprint along the emitter's outline (the
     // shared Cornell box's ceiling, 0.9 mm over its light, 20 mm texels), and
@@ -72,10 +74,8 @@ void main() {
         fMean = 0.0;
         for (uint k = 0u; k < NEAR_FIELD_POINTS; ++k) {
             vec2 o = footprintOffset(vBary, baryDx, baryDy, vFlags, cells, footprintSample * NEAR_FIELD_POINTS + k);
-            vec3 p = vPosition + positionDx * o.x + positionDy * o.y;
-            float side = dot(emitterNormal, p - emitterA);
-            if (emitterDoubleSided ? abs(side) <= planeEpsilon : side <= planeEpsilon) continue;
-            fMean += polygonFormFactor(p, normalize(vNormal + normalDx * o.x + normalDy * o.y), emitterA, emitterB, emitterC);
+            fMean += formFactorAt(vPosition + positionDx * o.x + positionDy * o.y,
+                                  normalize(vNormal + normalDx * o.x + normalDy * o.y));
         }
         fMean /= float(NEAR_FIELD_POINTS);
     }
