@@ -14,6 +14,12 @@
 //   mean_ratio  sum a / sum b                      (1 = no overall bias)
 //   mean_abs    mean |a - b|
 //   max_abs     max |a - b|
+// and rel_rmse over two parts of the compared texels (each still over mean b
+// of all, so that their squares, weighted by their shares of the texels, add
+// up to rel_rmse's): interior (the texel and its 8 neighbours all compared:
+// a whole square on one chart) and border (the rest: partial footprints,
+// chart seams), where a bake's sampling of a texel's footprint differs most
+// from a reference's.
 // The error image shows mean over channels |a - b| per texel, scaled so that
 // --scale (default: the 99th percentile over compared texels) is the top of
 // the colour ramp (black, blue, cyan, yellow, red, white at 2x); texels not
@@ -168,18 +174,27 @@ int runCompare(const CompareArgs& args) {
     }
 
     // metrics
-    int64_t n = 0;
-    double sumSq = 0, sumRel = 0, sumA = 0, sumB = 0, sumAbs = 0, maxAbs = 0;
+    int64_t n = 0, interior = 0;
+    double sumSq = 0, sumRel = 0, sumA = 0, sumB = 0, sumAbs = 0, maxAbs = 0, interiorSq = 0;
     std::vector<float> errors;
     for (size_t p = 0; p < mask.size(); ++p)
         for (size_t i = 0; i < mask[p].size(); ++i) {
             if (!mask[p][i]) continue;
             const glm::vec3 va = a->pages[p].pixels[i], vb = b->pages[p].pixels[i];
             ++n;
+            const int width = a->pages[p].width, height = a->pages[p].height;
+            const int x = int(i % size_t(width)), y = int(i / size_t(width));
+            bool inner = true;
+            for (int dy = -1; dy <= 1 && inner; ++dy)
+                for (int dx = -1; dx <= 1 && inner; ++dx)
+                    inner = x + dx >= 0 && x + dx < width && y + dy >= 0 && y + dy < height &&
+                            mask[p][size_t(y + dy) * size_t(width) + size_t(x + dx)];
+            interior += inner;
             float e = 0.0f;
             for (int c = 0; c < 3; ++c) {
                 double d = double(va[c]) - double(vb[c]);
                 sumSq += d * d;
+                if (inner) interiorSq += d * d;
                 sumRel += d * d / (double(vb[c]) * vb[c] + 1e-2);
                 sumA += va[c];
                 sumB += vb[c];
@@ -193,6 +208,10 @@ int runCompare(const CompareArgs& args) {
     const double values = 3.0 * double(n);
     const double rmse = std::sqrt(sumSq / values);
     const double meanB = sumB / values;
+    // rel_rmse over a part of the texels: its rms over mean b of all
+    auto partRelRmse = [&](double sq, int64_t texels) {
+        return texels > 0 && meanB != 0.0 ? std::sqrt(sq / (3.0 * double(texels))) / std::fabs(meanB) : 0.0;
+    };
     nlohmann::json result = {
         {"a", args.a},
         {"b", args.b},
@@ -207,9 +226,14 @@ int runCompare(const CompareArgs& args) {
         {"mean_abs", sumAbs / values},
         {"max_abs", maxAbs},
         {"mean_b", meanB},
+        {"interior_texels", interior},
+        {"interior_rel_rmse", partRelRmse(interiorSq, interior)},
+        {"border_rel_rmse", partRelRmse(sumSq - interiorSq, n - interior)},
         {"definitions",
          "over compared texels and the 3 channels: rmse = sqrt(mean (a-b)^2); rel_rmse = rmse / mean b; "
-         "rel_mse = mean (a-b)^2 / (b^2 + 0.01); mean_ratio = sum a / sum b; mean_abs = mean |a-b|; max_abs = max |a-b|"},
+         "rel_mse = mean (a-b)^2 / (b^2 + 0.01); mean_ratio = sum a / sum b; mean_abs = mean |a-b|; max_abs = max |a-b|; "
+         "interior_rel_rmse, border_rel_rmse: rms (a-b) over the texels whose 8 neighbours are compared too, and over "
+         "the rest, each / mean b of all"},
     };
 
     // error image
@@ -248,6 +272,10 @@ int runCompare(const CompareArgs& args) {
                 (long long)onlyA, (long long)onlyB);
     std::printf("rmse        %.6g\n", rmse);
     std::printf("rel_rmse    %.6g   (rmse / mean B = %.6g)\n", result["rel_rmse"].get<double>(), meanB);
+    std::printf("  interior  %.6g   (%lld texels whose 8 neighbours are compared too)\n",
+                result["interior_rel_rmse"].get<double>(), (long long)interior);
+    std::printf("  border    %.6g   (%lld texels: partial footprints, chart seams)\n",
+                result["border_rel_rmse"].get<double>(), (long long)(n - interior));
     std::printf("rel_mse     %.6g   (mean (a-b)^2 / (b^2 + 0.01))\n", result["rel_mse"].get<double>());
     std::printf("mean_ratio  %.6f   (sum A / sum B)\n", result["mean_ratio"].get<double>());
     std::printf("mean_abs    %.6g\n", sumAbs / values);
