@@ -135,7 +135,7 @@ std::vector<double> seamPairDifferences(const LightmapPages& maps, const Seams& 
 }
 
 nlohmann::json SeamStitchStats::toJson() const {
-    return {{"seam_edges", seamEdges}, {"hard_edges", hardEdges},   {"sample_pairs", samplePairs}, {"skipped_pairs", skippedPairs},
+    return {{"seam_edges", seamEdges}, {"hard_edges", hardEdges}, {"narrow_pairs", narrowPairs}, {"sample_pairs", samplePairs}, {"skipped_pairs", skippedPairs},
             {"texels_adjusted", texelsAdjusted}, {"rms_before", rmsBefore}, {"rms_after", rmsAfter},
             {"mean_value", meanValue}, {"seconds", seconds},        {"solved", solved}};
 }
@@ -145,6 +145,7 @@ SeamStitchStats stitchSeams(LightmapPages& maps, const Seams& seams, const SeamS
     SeamStitchStats st;
     st.seamEdges = seams.seamEdges;
     st.hardEdges = seams.hardEdges;
+    st.narrowPairs = seams.narrowPairs;
     const SeamDifference before = seamDifference(maps, seams);
     st.samplePairs = before.pairs;
     st.skippedPairs = before.skipped;

@@ -67,6 +67,7 @@ std::vector<double> seamPairDifferences(const LightmapPages& maps, const Seams& 
 struct SeamStitchStats {
     size_t seamEdges = 0;
     size_t hardEdges = 0;      // edges across charts with split normals: not stitched
+    size_t narrowPairs = 0;    // sample pairs where a side's chart owns no texel of its lookup: left out
     size_t samplePairs = 0;    // pairs stitched
     size_t skippedPairs = 0;   // pairs with a tap without a baked value: left alone
     size_t texelsAdjusted = 0; // texels in the solve (changed in general)

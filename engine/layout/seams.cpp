@@ -30,6 +30,25 @@ glm::vec3 faceNormal(const BakeMesh& mesh, uint32_t t) {
     return len > 0.0f ? n / len : glm::vec3(0.0f);
 }
 
+// Whether a bilinear lookup at `texel` (page texels, GL_LINEAR) reads chart
+// `chart`'s own light: of the four texels it taps, one at least is owned by
+// the chart and none by another (`owner`: texelOwners of the page; unowned
+// ones are padding, dilated from the chart's).
+bool ownLookup(const std::vector<int32_t>& owner, const std::vector<uint32_t>& chartOf, int res, glm::vec2 texel,
+               uint32_t chart) {
+    const int x0 = int(std::floor(texel.x - 0.5f)), y0 = int(std::floor(texel.y - 0.5f));
+    int owned = 0;
+    for (int y = y0; y <= y0 + 1; ++y)
+        for (int x = x0; x <= x0 + 1; ++x) {
+            if (x < 0 || y < 0 || x >= res || y >= res) continue;
+            const int32_t t = owner[size_t(y) * size_t(res) + size_t(x)];
+            if (t < 0) continue;
+            if (chartOf[size_t(t)] != chart) return false;
+            ++owned;
+        }
+    return owned > 0;
+}
+
 }  // namespace
 
 Seams findSeams(const BakeMesh& mesh, int resolution, const SeamOptions& options) {
@@ -115,7 +134,14 @@ Seams findSeams(const BakeMesh& mesh, int resolution, const SeamOptions& options
     });
     out.seamEdges = seamUses.size();
 
-    // sample pairs: n per edge at the centres of n equal parts
+    // sample pairs: n per edge at the centres of n equal parts, where both
+    // sides' charts own a texel of their lookups
+    const std::vector<uint32_t> chartOf = findLightmapCharts(mesh);
+    std::vector<std::vector<int32_t>> owners(mesh.pageFirstTriangle.size() - 1);
+    auto ownerOf = [&](uint32_t page) -> const std::vector<int32_t>& {
+        if (owners[page].empty()) owners[page] = texelOwners(mesh, int(page), resolution);
+        return owners[page];
+    };
     for (size_t seam = 0; seam < seamUses.size(); ++seam) {
         const EdgeUse& a = uses[seamUses[seam].first];
         const EdgeUse& b = uses[seamUses[seam].second];
@@ -125,10 +151,16 @@ Seams findSeams(const BakeMesh& mesh, int resolution, const SeamOptions& options
         const glm::vec2 b1 = mesh.vertices[3 * size_t(b.triangle) + b.cornerHi].lightmapUv * res;
         const float texels = std::max(glm::length(a1 - a0), glm::length(b1 - b0));
         const int n = std::max(2, int(std::ceil(texels * options.samplesPerTexel)));
+        const uint32_t pageA = mesh.triangles[a.triangle].page, pageB = mesh.triangles[b.triangle].page;
         for (int s = 0; s < n; ++s) {
             const float t = (float(s) + 0.5f) / float(n);
-            out.samples.push_back({uint32_t(seam), mesh.triangles[a.triangle].page, mesh.triangles[b.triangle].page,
-                                   a0 + (a1 - a0) * t, b0 + (b1 - b0) * t});
+            const glm::vec2 ta = a0 + (a1 - a0) * t, tb = b0 + (b1 - b0) * t;
+            if (!ownLookup(ownerOf(pageA), chartOf, resolution, ta, chartOf[a.triangle]) ||
+                !ownLookup(ownerOf(pageB), chartOf, resolution, tb, chartOf[b.triangle])) {
+                ++out.narrowPairs;
+                continue;
+            }
+            out.samples.push_back({uint32_t(seam), pageA, pageB, ta, tb});
         }
     }
     return out;

@@ -28,6 +28,13 @@ int& killCountdown(const char* value) {
 }
 }  // namespace
 
+void addSeamsOption(CLI::App& cmd, std::string& seams) {
+    cmd.add_option("--seams", seams,
+                   "UV seams: stitch (least squares over the texels along them, so both sides agree) or off")
+        ->check(CLI::IsMember({"stitch", "off"}))
+        ->capture_default_str();
+}
+
 void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
     addSceneOptions(cmd, a.scene);
     cmd.add_option("-o,--output", a.outDir, "Output directory (created if missing)")->required();
@@ -75,10 +82,7 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
                    "radiance refreshes from 16 directions on; --directions is then the most); 0 = off")
         ->check(CLI::Range(0.0, 1.0))
         ->capture_default_str();
-    cmd.add_option("--seams", a.seams,
-                   "UV seams: stitch (least squares over the texels along them, so both sides agree) or off")
-        ->check(CLI::IsMember({"stitch", "off"}))
-        ->capture_default_str();
+    addSeamsOption(cmd, a.seams);
     cmd.add_option("--checkpoint-every", a.checkpointEvery,
                    "Write OUTDIR/checkpoint.bin every N directions (0 = never)")
         ->check(CLI::NonNegativeNumber)

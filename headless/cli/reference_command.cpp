@@ -10,6 +10,7 @@
 #include <embree3/rtcore_config.h>
 
 #include "bake/bake_output.h"
+#include "bake/seam_stitch.h"
 #include "core/log.h"
 #include "headless/cli/options.h"
 #include "reference/reference_baker.h"
@@ -27,6 +28,7 @@ struct ReferenceArgs {
     std::string sky = "0,0,0";
     std::string env;
     std::string emitterSampling = "on";
+    std::string seams = "stitch";
     int rouletteDepth = 3;
     int maxBounces = 1000;
     bool preview = true;
@@ -74,14 +76,18 @@ int runReference(const ReferenceArgs& args) {
     info.settings = {{"spp", args.spp}, {"pass_spp", args.passSpp}, {"threads", (*baker)->stats().threads},
                      {"seed", args.seed}, {"sky", args.sky}, {"env", args.env},
                      {"emitter_sampling", args.emitterSampling}, {"roulette_depth", args.rouletteDepth},
-                     {"max_bounces", args.maxBounces},
+                     {"max_bounces", args.maxBounces}, {"seams", args.seams},
                      {"uv_layout", args.scene.uvLayout}, {"resolution", args.scene.resolution},
                      {"texel_density", args.scene.texelDensity}};
     info.wallSeconds = seconds;  // BVH build + tracing (not scene loading or writing)
     info.writePreviews = args.preview;
-    if (Status s = writeBakeOutputs(args.outDir, loaded->scene, loaded->layout, (*baker)->readLightmaps(),
-                                    (*baker)->stats().toJson(), info);
-        !s)
+    // the same light maps as a bake's: its seams stitched the same way (the same
+    // least squares over the same seams), unless --seams off
+    LightmapPages maps = (*baker)->readLightmaps();
+    nlohmann::json stats = (*baker)->stats().toJson();
+    if (args.seams == "stitch")
+        stats["seams"] = stitchSeams(maps, findSeams((*baker)->mesh(), maps.resolution)).toJson();
+    if (Status s = writeBakeOutputs(args.outDir, loaded->scene, loaded->layout, maps, stats, info); !s)
         return fail(s.message());
     logInfo("traced " + std::to_string(args.spp) + " spp in " + std::to_string(seconds) + " s -> " + args.outDir);
     return 0;
@@ -117,6 +123,7 @@ void addReferenceCommand(CLI::App& app, std::function<int()>& action) {
                     "Path vertices after the texel (1 = direct light only, as the GPU's first iteration)")
         ->check(CLI::Range(1, 100000))
         ->capture_default_str();
+    addSeamsOption(*cmd, a->seams);
     cmd->add_flag("--no-preview", [a](int64_t) { a->preview = false; }, "Do not write PNG previews");
     cmd->add_flag("--no-progress", [a](int64_t) { a->progress = false; }, "No progress line on stderr");
     cmd->callback([a, &action] { action = [a] { return runReference(*a); }; });

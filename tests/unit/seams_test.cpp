@@ -40,8 +40,11 @@ TEST(Seams, SplitDiagonalIsOneSeamSampledAlongBothSides) {
     const Seams s = findSeams(quadMesh({0.5f, 0}), 16);
     ASSERT_EQ(s.seamEdges, 1u);
     EXPECT_EQ(s.hardEdges, 0u);
-    // the diagonal is 16 x 0.25 x sqrt 2 = 5.66 texels: ceil(3 x 5.66) = 17 pairs
-    ASSERT_EQ(s.samples.size(), 17u);
+    // the diagonal is 16 x 0.25 x sqrt 2 = 5.66 texels: ceil(3 x 5.66) = 17
+    // pairs, less those at its two ends, where a side's lookup taps no texel
+    // its chart owns (the triangle's acute corners)
+    ASSERT_EQ(s.samples.size() + s.narrowPairs, 17u);
+    EXPECT_EQ(s.narrowPairs, 4u);
     for (const SeamSamplePair& p : s.samples) {
         // the same point of the edge on both sides: B is A moved by the offset (8 texels)
         EXPECT_NEAR(p.texelB.x - p.texelA.x, 8.0f, 1e-4f);
@@ -50,6 +53,16 @@ TEST(Seams, SplitDiagonalIsOneSeamSampledAlongBothSides) {
         EXPECT_GT(p.texelA.x, 0.0f);
         EXPECT_LT(p.texelA.x, 4.0f);
     }
+}
+
+// Two charts a quarter texel apart: each side's lookups tap texels the other
+// owns, so no lookup reads its own chart's light and no pair is kept (a
+// stitch would only pull the two charts' texels toward each other).
+TEST(Seams, ChartsCloserThanATexelKeepNoPairs) {
+    const Seams s = findSeams(quadMesh({1.0f / 64.0f, 0}), 16);
+    ASSERT_EQ(s.seamEdges, 1u);
+    EXPECT_TRUE(s.samples.empty());
+    EXPECT_EQ(s.narrowPairs, 17u);
 }
 
 TEST(Seams, HardEdgeAndOtherInstanceAreNotSeams) {
