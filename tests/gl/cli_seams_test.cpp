@@ -3,6 +3,7 @@
 // stitch (the default) reports the seams in stats.json with the seam RMS
 // lower after than before, and writes the same bytes twice; off reports
 // nothing, records the choice in stats.json's settings, and writes other light maps.
+// `bundlebake reference --seams` stitches the same seams.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -52,6 +53,33 @@ TEST(CliSeams, StitchReportsSeamsAndIsDeterministicOffLeavesThem) {
     EXPECT_FALSE(offStats.contains("seams"));
     EXPECT_EQ(offStats["settings"]["seams"], "off");
     EXPECT_NE(readFileBytes(tmp / "a/lightmap_0.exr"), readFileBytes(tmp / "off/lightmap_0.exr"));
+}
+
+// The reference stitches its light maps as the bake does (the same seams,
+// the same least squares), so the two are compared as the same product.
+TEST(CliSeams, ReferenceStitchesTheSameSeams) {
+    TempDir tmp("seams-reference");
+    ASSERT_TRUE(tmp.ok());
+    auto referenceArgs = [&](const std::string& out, const char* seams) {
+        return std::vector<std::string>{"reference", sourcePath("assets/shared/living_room/living_room.glb"), "-o",
+                                        tmp / out, "--sky", "1,1,1", "--resolution", "256", "--spp", "2",
+                                        "--seams", seams, "--no-preview", "--no-progress"};
+    };
+    const CliResult stitched = runCli(referenceArgs("stitched", "stitch"), tmp);
+    ASSERT_EQ(stitched.exitCode, 0) << stitched.err;
+    const CliResult off = runCli(referenceArgs("off", "off"), tmp);
+    ASSERT_EQ(off.exitCode, 0) << off.err;
+    const CliResult bake = runCli(bakeArgs(tmp / "bake"), tmp);
+    ASSERT_EQ(bake.exitCode, 0) << bake.err;
+
+    const nlohmann::json s = readJson(tmp / "stitched/stats.json");
+    ASSERT_TRUE(s.contains("seams")) << s.dump();
+    const nlohmann::json b = readJson(tmp / "bake/stats.json")["seams"];
+    for (const char* key : {"seam_edges", "hard_edges", "narrow_pairs", "sample_pairs"})
+        EXPECT_EQ(s["seams"][key], b[key]) << key;
+    EXPECT_LT(s["seams"]["rms_after"].get<double>(), 0.25 * s["seams"]["rms_before"].get<double>());
+    EXPECT_FALSE(readJson(tmp / "off/stats.json").contains("seams"));
+    EXPECT_NE(readFileBytes(tmp / "stitched/lightmap_0.exr"), readFileBytes(tmp / "off/lightmap_0.exr"));
 }
 
 TEST(CliSeams, RejectsUnknownMode) {
