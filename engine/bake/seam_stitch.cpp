@@ -135,9 +135,10 @@ std::vector<double> seamPairDifferences(const LightmapPages& maps, const Seams& 
 }
 
 nlohmann::json SeamStitchStats::toJson() const {
-    return {{"seam_edges", seamEdges}, {"hard_edges", hardEdges}, {"narrow_pairs", narrowPairs}, {"sample_pairs", samplePairs}, {"skipped_pairs", skippedPairs},
-            {"texels_adjusted", texelsAdjusted}, {"rms_before", rmsBefore}, {"rms_after", rmsAfter},
-            {"mean_value", meanValue}, {"seconds", seconds},        {"solved", solved}};
+    return {{"seam_edges", seamEdges},     {"hard_edges", hardEdges},         {"narrow_pairs", narrowPairs},
+            {"sample_pairs", samplePairs},   {"skipped_pairs", skippedPairs},   {"texels_adjusted", texelsAdjusted},
+            {"rms_before", rmsBefore},       {"rms_after", rmsAfter},           {"mean_value", meanValue},
+            {"seconds", seconds},            {"solved", solved}};
 }
 
 SeamStitchStats stitchSeams(LightmapPages& maps, const Seams& seams, const SeamStitchOptions& options) {

@@ -61,14 +61,10 @@ struct Seams {
     size_t seamEdges = 0;        // smooth edges whose two sides differ in page space
     size_t hardEdges = 0;        // edges whose sides differ in page space and in normal (shading or face): left alone
     size_t nonManifoldEdges = 0; // welded edges with more than two triangles: left alone
-    // Sample points where a side's chart owns none of the four texels its
-    // bilinear lookup taps (a chart a fraction of a texel wide there: the
-    // city's sills and parapet tops, a fifth of a texel) are left out: there
-    // is no texel of that chart for the two sides to agree on, and stitching
-    // them only moved texels away from their footprints' means (the converged
-    // reference's own lookups differ by 0.12 RMS, 23 % of the mean, across the
-    // city's seams; stitched, the bake's error against the unstitched
-    // reference rose from 3.2 to 4.2 %, bench city_sky, 1024 directions).
+    // Sample points where a side's bilinear lookup taps no texel owned by its
+    // chart, or one owned by another chart, are left out: a chart a fraction
+    // of a texel wide there (the bench city's sills and parapet tops) has no
+    // texel of its own for the two sides to agree on (docs/design-notes.md).
     size_t narrowPairs = 0;
     std::vector<SeamSamplePair> samples;  // seam by seam, in triangle order
 };
