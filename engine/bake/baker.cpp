@@ -124,7 +124,7 @@ nlohmann::json BakeStats::toJson() const {
                    {"by_category", categories},
                    {"node_capacity", nodeCapacity}, {"peak_nodes_per_tile", peakNodesPerTile},
                    {"node_buffer_bytes", nodeBufferBytes}, {"head_image_bytes", headImageBytes}, {"bytes_per_node", 12}};
-    j["lightmap"] = {{"texels", lightmapTexels}, {"covered_texels", coveredTexels}};
+    j["lightmap"] = {{"texels", lightmapTexels}, {"covered_texels", coveredTexels}, {"shared_texels", sharedTexels}};
     j["direct_light"] = {{"explicit_emitters", explicitEmitters}, {"emitter_samples", emitterSampleCount}};
     double bundleSeconds = secondsBundle > 0 ? secondsBundle : 1e-9;
     double updateSeconds = secondsUpdate > 0 ? secondsUpdate : 1e-9;
@@ -297,6 +297,7 @@ void Baker::Impl::coveragePass() {
         const std::vector<int32_t> owners = texelOwners(mesh, p, res);
         chartNeighbourBits(codes, owners, chart, res, neighbours);
         const std::vector<uint64_t> masks = footprintMasks(mesh, p, res, owners, chart);
+        stats.sharedTexels += int64_t(sharedTexels(mesh, p, res, owners, chart));
         gl::writeTexture(footprintCells.id(), 0, 0, p, res, res, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, masks.data());
         gl::writeTexture(chartNeighbours.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1,
                          neighbours.data());
@@ -304,6 +305,11 @@ void Baker::Impl::coveragePass() {
         gl::writeTexture(dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, codes.data());
     }
     stats.lightmapTexels = int64_t(res) * res * layout.pageCount;
+    if (stats.sharedTexels * 100 > stats.coveredTexels)  // over 1 %: worth the user's look
+        logWarning(std::to_string(stats.sharedTexels) + " of " + std::to_string(stats.coveredTexels) +
+                   " covered light map texels also hold part of another chart (TEXCOORD_1 charts closer than a texel "
+                   "at this density): their light bleeds between the charts; raise --resolution or --texel-density, "
+                   "or space the charts further apart");
 }
 
 void Baker::Impl::sanitizeInputs(const Scene& scene) {

@@ -112,6 +112,7 @@ struct BakeStats {
     std::map<std::string, int64_t> peakGpuBytesByCategory;  // MemoryCategory names
     int64_t lightmapTexels = 0;
     int64_t coveredTexels = 0;
+    int64_t sharedTexels = 0;  // covered texels another chart also overlaps (layout/bake_mesh.h sharedTexels)
     std::vector<double> predictedOverActual;  // per tile: predicted nodes / actual nodes
     std::vector<int> tilesPerDirection;
     std::vector<int> leavesPerDirection;

@@ -180,6 +180,47 @@ std::vector<uint64_t> footprintMasks(const BakeMesh& mesh, int page, int res, co
     return mask;
 }
 
+size_t sharedTexels(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,
+                    const std::vector<uint32_t>& chart) {
+    std::vector<uint8_t> shared(size_t(res) * res, 0);
+    size_t count = 0;
+    for (uint32_t t = mesh.pageFirstTriangle[size_t(page)]; t < mesh.pageFirstTriangle[size_t(page) + 1]; ++t) {
+        glm::dvec2 q[3];
+        const double absArea = pageCorners(mesh, t, res, q);
+        if (absArea == 0.0 || !std::isfinite(absArea)) continue;
+        // separating axes: the square's two and the triangle's three edge normals
+        glm::dvec2 axes[5] = {{1, 0}, {0, 1}};
+        for (int e = 0; e < 3; ++e) {
+            const glm::dvec2 d = q[(e + 1) % 3] - q[e];
+            axes[2 + e] = glm::dvec2(-d.y, d.x);
+        }
+        auto overlaps = [&](int x, int y) {
+            for (const glm::dvec2& a : axes) {
+                const double t0 = glm::dot(q[0], a), t1 = glm::dot(q[1], a), t2 = glm::dot(q[2], a);
+                const double lo = std::min({t0, t1, t2}), hi = std::max({t0, t1, t2});
+                // the square's extent along a: its lower corner's projection plus the positive parts
+                const double s0 = x * a.x + y * a.y;
+                const double sLo = s0 + std::min(a.x, 0.0) + std::min(a.y, 0.0);
+                const double sHi = s0 + std::max(a.x, 0.0) + std::max(a.y, 0.0);
+                if (hi <= sLo || sHi <= lo) return false;
+            }
+            return true;
+        };
+        const int x0 = std::max(0, int(std::floor(std::min({q[0].x, q[1].x, q[2].x}))));
+        const int x1 = std::min(res - 1, int(std::floor(std::max({q[0].x, q[1].x, q[2].x}))));
+        const int y0 = std::max(0, int(std::floor(std::min({q[0].y, q[1].y, q[2].y}))));
+        const int y1 = std::min(res - 1, int(std::floor(std::max({q[0].y, q[1].y, q[2].y}))));
+        for (int y = y0; y <= y1; ++y)
+            for (int x = x0; x <= x1; ++x) {
+                const size_t i = size_t(y) * res + x;
+                if (shared[i] || owner[i] < 0 || chart[size_t(owner[i])] == chart[t] || !overlaps(x, y)) continue;
+                shared[i] = 1;
+                ++count;
+            }
+    }
+    return count;
+}
+
 BakeMesh buildBakeMesh(const Scene& scene, const Layout& layout) {
     CHECK_EQ(layout.rects.size(), scene.instances.size());
     const size_t pageCount = size_t(layout.pageCount);

@@ -84,4 +84,12 @@ std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res);
 std::vector<uint64_t> footprintMasks(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,
                                      const std::vector<uint32_t>& chart);
 
+// How many covered texels of the page (owner >= 0) a triangle of another chart
+// also overlaps (with area: charts that only touch along a texel's border do
+// not count). Such a texel holds its owner's light, which bilinear filtering
+// and the bundle pass's radiance reads then give the other chart's surface
+// too: the asset's charts lie closer than a texel at this density.
+size_t sharedTexels(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,
+                    const std::vector<uint32_t>& chart);
+
 }  // namespace bb

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "bake/seam_stitch.h"
 #include "layout/seams.h"
@@ -63,6 +64,20 @@ TEST(Seams, ChartsCloserThanATexelKeepNoPairs) {
     ASSERT_EQ(s.seamEdges, 1u);
     EXPECT_TRUE(s.samples.empty());
     EXPECT_EQ(s.narrowPairs, 17u);
+}
+
+// The same two charts' texels: a quarter texel apart, the texels along their
+// diagonal hold parts of both; half a page apart, none does.
+TEST(SharedTexels, CountsTexelsAnotherChartAlsoOverlaps) {
+    auto shared = [](const BakeMesh& m) {
+        return sharedTexels(m, 0, 16, texelOwners(m, 0, 16), findLightmapCharts(m));
+    };
+    const size_t close = shared(quadMesh({1.0f / 64.0f, 0}));
+    std::printf("[shared] %zu\n", close);
+    EXPECT_GE(close, 4u);   // at least the diagonal's texels (it crosses 4 texels each way)
+    EXPECT_LE(close, 12u);  // and not the charts' inner texels
+    EXPECT_EQ(shared(quadMesh({0.5f, 0})), 0u);
+    EXPECT_EQ(shared(quadMesh({0, 0})), 0u);  // one chart: nothing shared
 }
 
 TEST(Seams, HardEdgeAndOtherInstanceAreNotSeams) {
