@@ -57,6 +57,17 @@ std::vector<LightmapEdge> sortedLightmapEdges(const BakeMesh& mesh) {
 
 bool sameEdge(const LightmapEdge& x, const LightmapEdge& y) { return x.page == y.page && x.a == y.a && x.b == y.b; }
 
+// The texels of a res x res page whose squares a page-space triangle's bounds touch.
+struct TexelRange {
+    int x0, x1, y0, y1;
+};
+TexelRange texelsUnder(const glm::dvec2 (&q)[3], int res) {
+    return {std::max(0, int(std::floor(std::min({q[0].x, q[1].x, q[2].x})))),
+            std::min(res - 1, int(std::floor(std::max({q[0].x, q[1].x, q[2].x})))),
+            std::max(0, int(std::floor(std::min({q[0].y, q[1].y, q[2].y})))),
+            std::min(res - 1, int(std::floor(std::max({q[0].y, q[1].y, q[2].y}))))};
+}
+
 }  // namespace
 
 std::vector<uint32_t> findLightmapCharts(const BakeMesh& mesh) {
@@ -159,12 +170,9 @@ std::vector<uint64_t> footprintMasks(const BakeMesh& mesh, int page, int res, co
             }
             return true;
         };
-        const int x0 = std::max(0, int(std::floor(std::min({q[0].x, q[1].x, q[2].x}))));
-        const int x1 = std::min(res - 1, int(std::floor(std::max({q[0].x, q[1].x, q[2].x}))));
-        const int y0 = std::max(0, int(std::floor(std::min({q[0].y, q[1].y, q[2].y}))));
-        const int y1 = std::min(res - 1, int(std::floor(std::max({q[0].y, q[1].y, q[2].y}))));
-        for (int y = y0; y <= y1; ++y)
-            for (int x = x0; x <= x1; ++x) {
+        const TexelRange r = texelsUnder(q, res);
+        for (int y = r.y0; y <= r.y1; ++y)
+            for (int x = r.x0; x <= r.x1; ++x) {
                 const size_t i = size_t(y) * res + x;
                 if (mask[i] == ~uint64_t(0) || chartAt(x, y) != int64_t(chart[t])) continue;
                 for (int cell = 0; cell < 64; ++cell) {
@@ -206,12 +214,9 @@ size_t sharedTexels(const BakeMesh& mesh, int page, int res, const std::vector<i
             }
             return true;
         };
-        const int x0 = std::max(0, int(std::floor(std::min({q[0].x, q[1].x, q[2].x}))));
-        const int x1 = std::min(res - 1, int(std::floor(std::max({q[0].x, q[1].x, q[2].x}))));
-        const int y0 = std::max(0, int(std::floor(std::min({q[0].y, q[1].y, q[2].y}))));
-        const int y1 = std::min(res - 1, int(std::floor(std::max({q[0].y, q[1].y, q[2].y}))));
-        for (int y = y0; y <= y1; ++y)
-            for (int x = x0; x <= x1; ++x) {
+        const TexelRange r = texelsUnder(q, res);
+        for (int y = r.y0; y <= r.y1; ++y)
+            for (int x = r.x0; x <= r.x1; ++x) {
                 const size_t i = size_t(y) * res + x;
                 if (shared[i] || owner[i] < 0 || chart[size_t(owner[i])] == chart[t] || !overlaps(x, y)) continue;
                 shared[i] = 1;
