@@ -188,6 +188,23 @@ std::vector<uint64_t> footprintMasks(const BakeMesh& mesh, int page, int res, co
     return mask;
 }
 
+std::vector<glm::dvec2> clipSquare(const glm::dvec2 (&tri)[3]) {
+    std::vector<glm::dvec2> poly = {{0, 0}, {1, 0}, {1, 1}, {0, 1}}, next;
+    for (int e = 0; e < 3 && !poly.empty(); ++e) {
+        const glm::dvec2 a = tri[e], d = tri[(e + 1) % 3] - tri[e];
+        auto side = [&](const glm::dvec2& p) { return d.x * (p.y - a.y) - d.y * (p.x - a.x); };  // >= 0: inside
+        next.clear();
+        for (size_t i = 0; i < poly.size(); ++i) {
+            const glm::dvec2 &p = poly[i], &q = poly[(i + 1) % poly.size()];
+            const double sp = side(p), sq = side(q);
+            if (sp >= 0.0) next.push_back(p);
+            if ((sp >= 0.0) != (sq >= 0.0)) next.push_back(p + (q - p) * (sp / (sp - sq)));
+        }
+        poly.swap(next);
+    }
+    return poly;
+}
+
 size_t sharedTexels(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,
                     const std::vector<uint32_t>& chart) {
     std::vector<uint8_t> shared(size_t(res) * res, 0);
@@ -196,23 +213,17 @@ size_t sharedTexels(const BakeMesh& mesh, int page, int res, const std::vector<i
         glm::dvec2 q[3];
         const double absArea = pageCorners(mesh, t, res, q);
         if (absArea == 0.0 || !std::isfinite(absArea)) continue;
-        // separating axes: the square's two and the triangle's three edge normals
-        glm::dvec2 axes[5] = {{1, 0}, {0, 1}};
-        for (int e = 0; e < 3; ++e) {
-            const glm::dvec2 d = q[(e + 1) % 3] - q[e];
-            axes[2 + e] = glm::dvec2(-d.y, d.x);
-        }
+        // overlapping with area: the square clipped to the triangle keeps some
         auto overlaps = [&](int x, int y) {
-            for (const glm::dvec2& a : axes) {
-                const double t0 = glm::dot(q[0], a), t1 = glm::dot(q[1], a), t2 = glm::dot(q[2], a);
-                const double lo = std::min({t0, t1, t2}), hi = std::max({t0, t1, t2});
-                // the square's extent along a: its lower corner's projection plus the positive parts
-                const double s0 = x * a.x + y * a.y;
-                const double sLo = s0 + std::min(a.x, 0.0) + std::min(a.y, 0.0);
-                const double sHi = s0 + std::max(a.x, 0.0) + std::max(a.y, 0.0);
-                if (hi <= sLo || sHi <= lo) return false;
+            const glm::dvec2 o(x, y);
+            const glm::dvec2 local[3] = {q[0] - o, q[1] - o, q[2] - o};
+            const std::vector<glm::dvec2> poly = clipSquare(local);
+            double area2 = 0.0;
+            for (size_t k = 0; k < poly.size(); ++k) {
+                const glm::dvec2 &a = poly[k], &b = poly[(k + 1) % poly.size()];
+                area2 += a.x * b.y - a.y * b.x;
             }
-            return true;
+            return area2 > 0.0;
         };
         const TexelRange r = texelsUnder(q, res);
         for (int y = r.y0; y <= r.y1; ++y)

@@ -84,6 +84,10 @@ std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res);
 std::vector<uint64_t> footprintMasks(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,
                                      const std::vector<uint32_t>& chart);
 
+// The unit square clipped to a counter-clockwise triangle (Sutherland-Hodgman):
+// the part of a texel's square (triangle in that texel's coordinates) on it.
+std::vector<glm::dvec2> clipSquare(const glm::dvec2 (&tri)[3]);
+
 // How many covered texels of the page (owner >= 0) a triangle of another chart
 // also overlaps (with area: charts that only touch along a texel's border do
 // not count). Such a texel holds its owner's light, which bilinear filtering

@@ -344,24 +344,6 @@ Status ReferenceBaker::Impl::init(const Scene& scene) {
 
 namespace {
 
-// The unit square clipped to a counter-clockwise triangle (Sutherland-Hodgman).
-std::vector<glm::dvec2> clipSquare(const glm::dvec2 (&tri)[3]) {
-    std::vector<glm::dvec2> poly = {{0, 0}, {1, 0}, {1, 1}, {0, 1}}, next;
-    for (int e = 0; e < 3 && !poly.empty(); ++e) {
-        const glm::dvec2 a = tri[e], d = tri[(e + 1) % 3] - tri[e];
-        auto side = [&](const glm::dvec2& p) { return d.x * (p.y - a.y) - d.y * (p.x - a.x); };  // >= 0: inside
-        next.clear();
-        for (size_t i = 0; i < poly.size(); ++i) {
-            const glm::dvec2 &p = poly[i], &q = poly[(i + 1) % poly.size()];
-            const double sp = side(p), sq = side(q);
-            if (sp >= 0.0) next.push_back(p);
-            if ((sp >= 0.0) != (sq >= 0.0)) next.push_back(p + (q - p) * (sp / (sp - sq)));
-        }
-        poly.swap(next);
-    }
-    return poly;
-}
-
 double cross2(const glm::dvec2& a, const glm::dvec2& b) { return a.x * b.y - a.y * b.x; }
 
 // Barycentrics moved a hair (1e-5 of the way) towards the centroid, clamped
