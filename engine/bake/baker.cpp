@@ -175,6 +175,9 @@ Status Baker::Impl::buildPrograms() {
 
 void Baker::Impl::uploadMesh() {
     MemoryCategory category("mesh");
+    charts = findLightmapCharts(mesh);
+    for (size_t t = 0; t < mesh.triangles.size(); ++t)
+        mesh.triangles[t].flags |= (charts[t] & 0xffffu) << TRIANGLE_CHART_SHIFT;
     vertexBuffer = gl::Buffer::create("bake vertices", int64_t(mesh.vertices.size() * sizeof(BakeVertex)),
                                       mesh.vertices.data(), 0);
     triangleBuffer = gl::Buffer::create("bake triangles", int64_t(mesh.triangles.size() * sizeof(BakeTriangle)),
@@ -290,14 +293,17 @@ void Baker::Impl::coveragePass() {
     const int res = layout.resolution;
     const int radius = std::min(std::max(layout.padding, 1) + 1, DILATION_RADIUS);
     std::vector<uint8_t> codes(size_t(res) * res), neighbours(codes.size());
-    const std::vector<uint32_t> chart = findLightmapCharts(mesh);
+    std::vector<uint16_t> ownerCharts(codes.size());
     for (int p = 0; p < layout.pageCount; ++p) {
         gl::readTexture(dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, codes.data());
         stats.coveredTexels += std::count(codes.begin(), codes.end(), uint8_t(DILATION_SELF));
         const std::vector<int32_t> owners = texelOwners(mesh, p, res);
-        chartNeighbourBits(codes, owners, chart, res, neighbours);
-        const std::vector<uint64_t> masks = footprintMasks(mesh, p, res, owners, chart);
-        stats.sharedTexels += int64_t(sharedTexels(mesh, p, res, owners, chart));
+        chartNeighbourBits(codes, owners, charts, res, neighbours);
+        for (size_t i = 0; i < owners.size(); ++i)
+            ownerCharts[i] = uint16_t(owners[i] < 0 ? 0xffffu : charts[size_t(owners[i])] & 0xffffu);
+        gl::writeTexture(texelCharts.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_SHORT, 2, ownerCharts.data());
+        const std::vector<uint64_t> masks = footprintMasks(mesh, p, res, owners, charts);
+        stats.sharedTexels += int64_t(sharedTexels(mesh, p, res, owners, charts));
         gl::writeTexture(footprintCells.id(), 0, 0, p, res, res, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, masks.data());
         gl::writeTexture(chartNeighbours.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1,
                          neighbours.data());
@@ -482,6 +488,7 @@ Status Baker::Impl::init(const Scene& scene) {
         dilation = gl::Texture::create2DArray("dilation codes", GL_R8UI, res, res, pages);
         chartNeighbours = gl::Texture::create2DArray("same-chart neighbours", GL_R8UI, res, res, pages);
         footprintCells = gl::Texture::create2DArray("footprint cells on the chart", GL_RG32UI, res, res, pages);
+        texelCharts = gl::Texture::create2DArray("texel owners' charts", GL_R16UI, res, res, pages);
         readModes = gl::Texture::create2DArray("radiance read modes", GL_R8UI, res, res, stateLayers());
         accumAsFloat = gl::Texture::createView("accumulators as rg32f (direct light sums)", accum, GL_RG32F);
         radianceBits = gl::Texture::createView("outgoing radiance as r32ui", radiance, GL_R32UI);
@@ -489,7 +496,7 @@ Status Baker::Impl::init(const Scene& scene) {
     }
     stats.lightmapStateBytes =
         accum.bytes() + radiance.bytes() + direct.bytes() + dilation.bytes() + chartNeighbours.bytes() + readModes.bytes() +
-        footprintCells.bytes();
+        footprintCells.bytes() + texelCharts.bytes();
     {
         // the noise estimate's half: about 256^2 sampled texels a page, every texel of small pages
         MemoryCategory category("noise estimate");
@@ -563,7 +570,7 @@ Status Baker::Impl::init(const Scene& scene) {
         // the bundle pass: its buffers start small and grow to what the tiles predict
         MemoryCategory category("bundles");
         const BundleScene scene{&mesh, &clusters, vao.id(), vertexBuffer.id(), triangleBuffer.id(),
-                                radiance.id(), readModes.id(), pageFbo.id(), res,
+                                radiance.id(), readModes.id(), texelCharts.id(), pageFbo.id(), res,
                                 materialAlphaBuffer.id(), alphaTexelBuffer.id(), backLayerOffset};
         const BundleLimits limits{nodeCapacity, maxTileSize, subpixelBits, options.predictTiles};
         auto t = BundleTracer::create(scene, limits, roundingDefine() + backSidesDefine(), &stats);

@@ -44,7 +44,7 @@ struct BakeOptions {
     // grid over the whole scene at the mean texel density, cut into tiles.
     enum class Tiling { Adaptive, Uniform } tiling = Tiling::Adaptive;
     bool cull = true;                 // per tile, draw only the clusters whose bounds meet it (both passes)
-    // GL bytes for the whole bake: light-map state (31 bytes a page texel, 44
+    // GL bytes for the whole bake: light-map state (33 bytes a page texel, 46
     // with double-sided materials), mesh (172 bytes a triangle), materials, and
     // what is left for one tile's node buffer and head image. A bake that does
     // not fit fails at create().

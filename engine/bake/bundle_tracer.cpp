@@ -161,6 +161,7 @@ void BundleTracer::next(const UpdateFn& update) {
         glBindImageTexture(BINDING_HEADS, heads_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
         glBindTextureUnit(BINDING_RADIANCE, scene_.radiance);
         glBindTextureUnit(BINDING_READ_MODES, scene_.readModes);
+        glBindTextureUnit(BINDING_TEXEL_CHARTS, scene_.texelCharts);
         drawClusters(append_.id(), tile.clusters, false);
         glDisable(GL_SCISSOR_TEST);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |

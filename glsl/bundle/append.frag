@@ -28,6 +28,7 @@ layout(binding = BINDING_HEADS, r32ui) uniform coherent uimage2D heads;
 layout(std430, binding = BINDING_NODES) buffer Nodes { Node nodes[]; };
 layout(binding = BINDING_RADIANCE) uniform sampler2DArray radiance;
 layout(binding = BINDING_READ_MODES) uniform usampler2DArray readModes;
+layout(binding = BINDING_TEXEL_CHARTS) uniform usampler2DArray texelCharts;
 
 uniform uint nodeCapacity;
 uniform uint randomSeed;  // per direction and leaf (not per tile: tiles change with the budget, the bytes must not)
@@ -56,18 +57,38 @@ vec3 axisOffset(uint mode, vec3 l, vec3 m, vec3 r, float x) {
     return mode == READ_NONE ? vec3(0.0) : offset;
 }
 
-// Outgoing radiance where a fragment lands, light-map position uv on layer
-// `layer` (its page or its back sides' layer): its texel's mean plus an
-// offset along each axis from the texels next to it on the same chart (none
-// from another chart or padding, so no light crosses), kept within their
-// range. A ray that meets the dark side of a texel a shadow, a contact or a
-// slot's rim crosses reads the dark side's light, not the texel's mean
-// (design notes, "Radiance reads"). Six fetches a fragment: what could be
-// decided once per texel is (read_modes.comp), as llvmpipe runs every fetch.
-vec3 radianceAt(vec2 uv, int layer) {
+// The texel whose radiance a fragment of chart `chart` reads at texel position
+// t (page texels minus 1/2): the nearest, c, unless another chart owns it
+// (charts closer than a texel: its light is the other chart's surface's, a
+// wall's seen on the sill beside it), then the nearest of the three next to c
+// toward t that the fragment's own chart owns; c where none is.
+ivec2 ownTexel(vec2 t, ivec2 c, ivec2 size, int page, uint chart) {
+    if (texelFetch(texelCharts, ivec3(c, page), 0).r == chart) return c;
+    vec2 f = t - vec2(c);
+    ivec2 toward = ivec2(f.x < 0.0 ? -1 : 1, f.y < 0.0 ? -1 : 1);
+    bool alongX = abs(f.x) >= abs(f.y);  // the step along x brings the centre nearer than along y
+    ivec2 order[3] = ivec2[3](alongX ? ivec2(toward.x, 0) : ivec2(0, toward.y),
+                              alongX ? ivec2(0, toward.y) : ivec2(toward.x, 0), toward);
+    for (int k = 0; k < 3; ++k) {
+        ivec2 n = clamp(c + order[k], ivec2(0), size - 1);
+        if (texelFetch(texelCharts, ivec3(n, page), 0).r == chart) return n;
+    }
+    return c;
+}
+
+// Outgoing radiance where a fragment of chart `chart` lands, light-map
+// position uv on page `page`, layer `layer` (the page or its back sides'
+// layer): its texel's (ownTexel) mean plus an offset along each axis from the
+// texels next to it on the same chart (none from another chart or padding, so
+// no light crosses), kept within their range. A ray that meets the dark side
+// of a texel a shadow, a contact or a slot's rim crosses reads the dark side's
+// light, not the texel's mean (design notes, "Radiance reads"). Six fetches a
+// fragment and one to four for its texel's chart: what could be decided once
+// per texel is (read_modes.comp), as llvmpipe runs every fetch.
+vec3 radianceAt(vec2 uv, int page, int layer, uint chart) {
     ivec2 size = textureSize(radiance, 0).xy;
     vec2 t = uv * vec2(size) - 0.5;
-    ivec2 c = clamp(ivec2(floor(t + 0.5)), ivec2(0), size - 1);
+    ivec2 c = ownTexel(t, clamp(ivec2(floor(t + 0.5)), ivec2(0), size - 1), size, page, chart);
     vec2 f = clamp(t - vec2(c), vec2(-0.5), vec2(0.5));
     uint modes = texelFetch(readModes, ivec3(c, layer), 0).r;
     vec3 m = texelFetch(radiance, ivec3(c, layer), 0).rgb;
@@ -97,7 +118,8 @@ void main() {
     vec3 u = vec3(uniform01(h), uniform01(pcgHash(h)), uniform01(pcgHash(h + 1u)));
     // the side the triangle's front faces (its texels' side, update.frag)
     uint front = dot(vFaceNormal, bundleDir) < 0.0 ? NODE_VISIBLE_FROM_BEHIND : NODE_VISIBLE_FROM_AHEAD;
-    uint radianceFront = encodeRgbe(radianceAt(lightmapUv, int(vPage)), u);
+    uint chart = vFlags >> TRIANGLE_CHART_SHIFT;
+    uint radianceFront = encodeRgbe(radianceAt(lightmapUv, int(vPage), int(vPage), chart), u);
     // A double-sided surface is seen from both sides: one node for both where
     // they look the same, else a second node at the same depth for its back
     // side's own radiance (update.frag tells the two apart by their sides),
@@ -108,7 +130,7 @@ void main() {
     // (only built for scenes with back sides: llvmpipe runs the fetch of a
     // branch no lane takes, 25 % of the pass)
     if (twoSides) {
-        vec3 lo = radianceAt(lightmapUv, int(vPage) + backLayerOffset);
+        vec3 lo = radianceAt(lightmapUv, int(vPage), int(vPage) + backLayerOffset, chart);
         radianceBack = encodeRgbe(lo, u);
     }
 #endif

@@ -17,6 +17,10 @@
 // space. A texel's footprint ends there (lib/texel_footprint.glsl); across an
 // edge the chart shares, it goes on in the neighbour. Bit k: TRIANGLE_CHART_BORDER0 << k.
 #define TRIANGLE_CHART_BORDER0 16u
+// Bits 16-31: the low 16 bits of the triangle's light map chart
+// (findLightmapCharts), set by the baker for the bundle pass, which reads no
+// texel another chart owns (glsl/bundle/append.frag, texelCharts).
+#define TRIANGLE_CHART_SHIFT 16u
 
 // SSBO binding of BakeTriangle triangles[] (lib/bake_vertex.glsl), bound in
 // chunks by MeshChunks (engine/layout/bake_mesh_gl.h)
