@@ -482,7 +482,7 @@ Status Baker::Impl::init(const Scene& scene) {
     const int pages = layout.pageCount, res = layout.resolution;
     {
         MemoryCategory category("light maps");
-        accum = gl::Texture::create2DArray("accumulators (fp16 RGB + W)", GL_RG32UI, res, res, stateLayers());
+        accum = gl::Texture::create2DArray("accumulators (mean RGB + W)", GL_RG32UI, res, res, stateLayers());
         radiance = gl::Texture::create2DArray("outgoing radiance (RGB9E5)", GL_RGB9_E5, res, res, stateLayers());
         direct = gl::Texture::create2DArray("direct light (fp16)", GL_RGBA16F, res, res, pages);
         dilation = gl::Texture::create2DArray("dilation codes", GL_R8UI, res, res, pages);
@@ -721,10 +721,10 @@ std::vector<std::vector<glm::vec4>> Baker::readAccumulators() {
     std::vector<std::vector<glm::vec4>> out(size_t(m.layout.pageCount));
     for (int p = 0; p < m.layout.pageCount; ++p) {
         gl::readTexture(m.accum.id(), 0, 0, p, res, res, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
-        for (const glm::uvec2& v : raw)
-            out[size_t(p)].push_back(glm::vec4(glm::vec3(halfToFloat(uint16_t(v.x & 0xFFFF)), halfToFloat(uint16_t(v.x >> 16)),
-                                                         halfToFloat(uint16_t(v.y & 0xFFFF))) * m.radianceUnit,
-                                               halfToFloat(uint16_t(v.y >> 16))));
+        for (const glm::uvec2& v : raw) {
+            const glm::vec4 state = decodeAccumulator(v);
+            out[size_t(p)].push_back(glm::vec4(glm::vec3(state) * m.radianceUnit, state.a));
+        }
     }
     return out;
 }

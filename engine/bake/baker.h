@@ -199,7 +199,7 @@ public:
     // Reads the current light maps back (resolve + dilate on the GPU).
     LightmapPages readLightmaps();
     // Raw accumulator read-back for tests: per page, per texel (mean R, G, B of the
-    // cosine-weighted incoming radiance, weight W) as stored in fp16.
+    // cosine-weighted incoming radiance, weight W) as stored (bake/rounding.h's accumulator).
     std::vector<std::vector<glm::vec4>> readAccumulators();
 
     // One bundle along d drawn as a single tile, read back (tests, tools):

@@ -52,7 +52,7 @@ struct Baker::Impl {
     gl::Buffer vertexBuffer, triangleBuffer, metaIndexBuffer;
     gl::VertexArray vao;
     // Light-map state, per page texel (33 bytes, 46 with back sides; BakeStats::memory):
-    //   accum      RG32UI  the running mean of incoming radiance (fp16 RGB) and its weight (fp16)
+    //   accum      RG32UI  the running mean of incoming radiance and its weight (lib/rounding.glsl's accumulator)
     //   radiance   RGB9_E5 outgoing radiance Lo the bundle pass samples (meta.frag writes it)
     //   direct     RGBA16F direct light L_lm (sun + explicit emitters)
     //   dilation   R8UI    the covered texel each texel shows (DILATION_* codes)

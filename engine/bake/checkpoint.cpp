@@ -17,7 +17,7 @@
 namespace bb {
 
 namespace {
-constexpr char CHECKPOINT_MAGIC[8] = {'B', 'B', 'C', 'K', 'P', 'T', '0', '5'};
+constexpr char CHECKPOINT_MAGIC[8] = {'B', 'B', 'C', 'K', 'P', 'T', '0', '6'};
 
 uint64_t fnv1a(const void* data, size_t bytes, uint64_t h = 1469598103934665603ull) {
     const auto* p = static_cast<const uint8_t*>(data);

@@ -136,11 +136,11 @@ void Baker::Impl::combineShares(int round) {
             gl::readTexture(texture.id(), 0, 0, p, width, width, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
             sums.assign(covered.size() * 4, 0.0f);
             for (size_t i = 0; i < covered.size(); ++i) {
-                const glm::uvec2 v = raw[covered[i]];
-                const float w = halfToFloat(uint16_t(v.y >> 16)) * toCommon;
-                sums[4 * i + 0] = halfToFloat(uint16_t(v.x & 0xFFFF)) * w;
-                sums[4 * i + 1] = halfToFloat(uint16_t(v.x >> 16)) * w;
-                sums[4 * i + 2] = halfToFloat(uint16_t(v.y & 0xFFFF)) * w;
+                const glm::vec4 state = decodeAccumulator(raw[covered[i]]);
+                const float w = state.a * toCommon;
+                sums[4 * i + 0] = state.r * w;
+                sums[4 * i + 1] = state.g * w;
+                sums[4 * i + 2] = state.b * w;
                 sums[4 * i + 3] = w;
             }
             share.sum(sums.data(), sums.size());
@@ -151,12 +151,10 @@ void Baker::Impl::combineShares(int round) {
                 const float w = sums[4 * i + 3];
                 const glm::vec3 mean = w > 0.0f ? glm::vec3(sums[4 * i], sums[4 * i + 1], sums[4 * i + 2]) / w : glm::vec3(0.0f);
                 const size_t texel = size_t(p) * pageTexels + covered[i];
-                uint16_t h[4];
-                for (uint32_t c = 0; c < 3; ++c) h[c] = floatToHalf(mean[int(c)], options.rounding, rnd(texel, c));
                 // a sampled texel stays sampled (W > 0), as rescale.comp keeps it
                 const float kept = w > 0.0f ? std::max(w, float(SAMPLED_MIN_WEIGHT)) : 0.0f;
-                h[3] = floatToHalf(kept, options.rounding, rnd(texel, 3));
-                raw[covered[i]] = glm::uvec2(h[0] | uint32_t(h[1]) << 16, h[2] | uint32_t(h[3]) << 16);
+                raw[covered[i]] = encodeAccumulator(glm::vec4(mean, kept), options.rounding,
+                                                    glm::vec4(rnd(texel, 0), rnd(texel, 1), rnd(texel, 2), rnd(texel, 3)));
             }
             gl::writeTexture(texture.id(), 0, 0, p, width, width, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
         }

@@ -89,6 +89,58 @@ uint32_t encodeRgbe(glm::vec3 rgb, Rounding mode, glm::vec3 u) {
     return 0;  // unreachable: after the carry every mantissa is <= 128
 }
 
+// floor(x) + 1 with probability fract(x) (exact: floor(x + u) would round
+// x + u to a float first, a bias of up to 2^-9 of a step at 16 bits)
+float roundUpWithProbability(float x, float u) {
+    const float f = std::floor(x);
+    return u < x - f ? f + 1.0f : f;
+}
+
+uint32_t encodeAccumulatorWeight(float w, Rounding mode, float u) {
+    if (mode == Rounding::Nearest) u = 0.5f;
+    if (!(w > 0.0f)) return 0;
+    constexpr float LARGEST = 64512.0f;  // the largest fp16 with 7 significant bits
+    w = std::min(w, LARGEST);
+    int e = 0;
+    std::frexp(w, &e);
+    const int k = std::max(e - 1, -14) - 6;  // w's ulp: 2^k
+    const float q = std::min(std::ldexp(roundUpWithProbability(std::ldexp(w, -k), u), k), LARGEST);
+    return uint32_t(imath_float_to_half(q) & 0x7FFF) >> 4;  // exact: q has 7 significant bits
+}
+
+float decodeAccumulatorWeight(uint32_t bits) { return imath_half_to_float(uint16_t((bits & 0x7FFu) << 4)); }
+
+glm::uvec2 encodeAccumulator(glm::vec4 s, Rounding mode, glm::vec4 u) {
+    if (mode == Rounding::Nearest) u = glm::vec4(0.5f);
+    glm::vec3 c(s);
+    for (int i = 0; i < 3; ++i) c[i] = c[i] > 0.0f ? std::min(c[i], 65535.0f) : 0.0f;  // NaN -> 0 too
+    const float maxc = std::max({c.r, c.g, c.b});
+    uint32_t q[3] = {0, 0, 0};
+    int ex = 0;
+    if (maxc > 0.0f) {
+        int e = 0;
+        std::frexp(maxc, &e);  // maxc < 2^e
+        ex = std::clamp(e + 15, 0, 31);
+        const auto round = [&]() {
+            for (int i = 0; i < 3; ++i) q[i] = uint32_t(roundUpWithProbability(std::ldexp(c[i], 31 - ex), u[i]));
+        };
+        round();
+        if (std::max({q[0], q[1], q[2]}) > 65535u && ex < 31) {
+            ex += 1;  // a mantissa rounded up to 2^16: carry into the exponent and round again
+            round();
+        }
+        for (uint32_t& qi : q) qi = std::min(qi, 65535u);
+    }
+    return glm::uvec2(q[0] | (q[1] << 16),
+                      q[2] | (uint32_t(ex) << 16) | (encodeAccumulatorWeight(s.a, mode, u.a) << 21));
+}
+
+glm::vec4 decodeAccumulator(glm::uvec2 p) {
+    const int k = int((p.y >> 16) & 31u) - 31;
+    return glm::vec4(std::ldexp(float(p.x & 0xFFFFu), k), std::ldexp(float(p.x >> 16), k),
+                     std::ldexp(float(p.y & 0xFFFFu), k), decodeAccumulatorWeight(p.y >> 21));
+}
+
 glm::vec3 decodeRgbe(uint32_t rgbe) {
     const int eb = int(rgbe >> 24);
     if (eb == 0) return glm::vec3(0.0f);

@@ -1,4 +1,5 @@
-// Lower-precision storage with stochastic rounding (unbiased): fp16 for light
+// Lower-precision storage with stochastic rounding (unbiased): fp16 for the
+// direct light, a shared-exponent RGB and a short float weight for the light
 // map accumulators, RGBE (Ward's shared-exponent, 8-bit mantissas) for bundle
 // nodes. The GLSL twins are in glsl/lib/rounding.glsl; these CPU versions are
 // the reference the tests hold the shaders to, and they decode readbacks.
@@ -29,6 +30,17 @@ float halfToFloat(uint16_t h);
 // Negative inputs are clamped to 0. Max ~ 2^119.
 uint32_t encodeRgbe(glm::vec3 rgb, Rounding mode, glm::vec3 u);
 glm::vec3 decodeRgbe(uint32_t rgbe);
+
+// The light map accumulators (a running mean RGB and its weight W) in 64
+// bits, an rg32ui texel (x, y): RGB with a shared exponent e and 16-bit
+// mantissas, value = m * 2^(e - 31) (e in 0..31, up to 65535), W as an fp16
+// without sign and its 4 low mantissa bits (7 significant bits);
+// x = r | g << 16, y = b | e << 16 | w << 21. u: one random number per
+// channel (rgb, W); NaN and negatives -> 0, larger values saturate.
+glm::uvec2 encodeAccumulator(glm::vec4 meanAndWeight, Rounding mode, glm::vec4 u);
+glm::vec4 decodeAccumulator(glm::uvec2 bits);
+uint32_t encodeAccumulatorWeight(float w, Rounding mode, float u);  // the 11 bits of W
+float decodeAccumulatorWeight(uint32_t bits);
 
 // Deterministic hash-based random numbers shared with GLSL (PCG hash,
 // Jarzynski & Olano 2020). uniform01 returns [0,1) with 24 bits.

@@ -1,5 +1,5 @@
-// GLSL twins of engine/bake/rounding.cpp: PCG hash random numbers, fp16 and
-// RGBE encodings with stochastic or nearest rounding. ROUNDING_NEAREST (a
+// GLSL twins of engine/bake/rounding.cpp: PCG hash random numbers, fp16,
+// RGBE and accumulator encodings with stochastic or nearest rounding. ROUNDING_NEAREST (a
 // define) selects the biased path kept for tests.
 
 uint pcgHash(uint v) {
@@ -90,4 +90,72 @@ uint encodeRgb9e5(vec3 c, vec3 u) {
 vec3 decodeRgb9e5(uint v) {
     vec3 m = vec3(float(v & 511u), float((v >> 9u) & 511u), float((v >> 18u) & 511u));
     return m * exp2(float(int(v >> 27u) - 24));
+}
+
+// The light map accumulators (update.frag's running mean and its weight) in
+// an rg32ui texel: RGB with a shared exponent e and 16-bit mantissas, value
+// = m * 2^(e - 31) (e in 0..31: up to 65535), and the weight W as an fp16
+// without its sign and four low mantissa bits (11 bits: 7 significant):
+// x = r | g << 16, y = b | e << 16 | w << 21. The mean is kept to 1/32768 of
+// its largest channel, 32 times finer than fp16: the rounding of a running
+// mean adds noise at every sample that grows like sqrt(N) (fp16: 1 % of the
+// mean at 4096 samples where L_in varies as much as the mean); W's coarse
+// bits only perturb the samples' weights a little (a few % in W, 0.1 % in
+// the mean's noise). Stochastic rounding by u (or nearest); NaN and
+// negatives -> 0, beyond the largest values saturates.
+// floor(x) + 1 with probability fract(x) (exact: floor(x + u) would round
+// x + u to a float first, a bias of up to 2^-9 of a step at 16 bits)
+float roundUpWithProbability(float x, float u) {
+    float f = floor(x);
+    return u < x - f ? f + 1.0 : f;
+}
+
+uint encodeAccumulatorWeight(float w, float u) {
+#ifdef ROUNDING_NEAREST
+    u = 0.5;
+#endif
+    if (!(w > 0.0)) return 0u;
+    w = min(w, 64512.0);  // the largest 7-bit-significand fp16
+    int e;
+    frexp(w, e);  // w = f * 2^e, f in [0.5, 1)
+    int k = max(e - 1, -14) - 6;  // w's ulp: 2^k
+    float q = min(ldexp(roundUpWithProbability(ldexp(w, -k), u), k), 64512.0);
+    return (packHalf2x16(vec2(q, 0.0)) & 0x7FFFu) >> 4u;
+}
+
+float decodeAccumulatorWeight(uint bits) { return unpackHalf2x16((bits & 0x7FFu) << 4u).x; }
+
+uvec3 accumulatorMantissas(vec3 c, int ex, vec3 u) {
+    return uvec3(roundUpWithProbability(ldexp(c.r, 31 - ex), u.r), roundUpWithProbability(ldexp(c.g, 31 - ex), u.g),
+                 roundUpWithProbability(ldexp(c.b, 31 - ex), u.b));
+}
+
+uvec2 encodeAccumulator(vec4 s, vec4 u) {
+#ifdef ROUNDING_NEAREST
+    u = vec4(0.5);
+#endif
+    vec3 c = s.rgb;
+    bvec3 nan = isnan(c);
+    c = clamp(vec3(nan.x ? 0.0 : c.x, nan.y ? 0.0 : c.y, nan.z ? 0.0 : c.z), vec3(0.0), vec3(65535.0));
+    float m = max(c.r, max(c.g, c.b));
+    uvec3 q = uvec3(0u);
+    int ex = 0;
+    if (m > 0.0) {
+        int e;
+        frexp(m, e);  // m < 2^e
+        ex = clamp(e + 15, 0, 31);
+        q = accumulatorMantissas(c, ex, u.rgb);
+        if (max(q.r, max(q.g, q.b)) > 65535u && ex < 31) {
+            ex += 1;  // a mantissa rounded up to 2^16: carry into the exponent and round again
+            q = accumulatorMantissas(c, ex, u.rgb);
+        }
+        q = min(q, uvec3(65535u));
+    }
+    return uvec2(q.r | (q.g << 16u), q.b | (uint(ex) << 16u) | (encodeAccumulatorWeight(s.a, u.a) << 21u));
+}
+
+vec4 decodeAccumulator(uvec2 p) {
+    vec3 m = vec3(float(p.x & 0xFFFFu), float(p.x >> 16u), float(p.y & 0xFFFFu));
+    int k = int((p.y >> 16u) & 31u) - 31;
+    return vec4(ldexp(m, ivec3(k)), decodeAccumulatorWeight(p.y >> 21u));
 }

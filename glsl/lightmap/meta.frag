@@ -48,8 +48,8 @@ void main() {
     vec3 e = emission;
     if (hasEmissionTexture) e *= texture(emissionTexture, vUv0).rgb;
     ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), page + layerOffset);
-    uvec2 p = imageLoad(accum, texel).rg;
-    vec3 l = halfToFloat(p.y >> 16u) > 0.0 ? vec3(halfToFloat(p.x), halfToFloat(p.x >> 16u), halfToFloat(p.y)) : vec3(0.0);
+    vec4 state = decodeAccumulator(imageLoad(accum, texel).rg);
+    vec3 l = state.a > 0.0 ? state.rgb : vec3(0.0);
     if (layerOffset == 0) l += imageLoad(directMap, texel).rgb;
     vec3 lo = (includeEmission ? e : vec3(0.0)) + clamp(a, 0.0, 1.0) * l;
     uint h = pcgHash(randomSeed ^ pcgHash(uint(texel.x) | (uint(texel.y) << 16u)) ^ pcgHash(uint(texel.z) + 7919u));

@@ -19,17 +19,13 @@ uniform int halfStride;
 uniform int pageCount;
 uniform ivec2 pageSize;  // of halfAccum
 
-vec4 unpackState(uvec2 p) {
-    return vec4(halfToFloat(p.x), halfToFloat(p.x >> 16u), halfToFloat(p.y), halfToFloat(p.y >> 16u));
-}
-
 void main() {
     ivec3 h = ivec3(gl_GlobalInvocationID.xy, gl_GlobalInvocationID.z);
     if (h.x >= pageSize.x || h.y >= pageSize.y || h.z >= pageCount) return;
-    vec4 whole = unpackState(imageLoad(accum, ivec3(h.xy * halfStride, h.z)).rg);
-    vec4 odd = unpackState(imageLoad(halfAccum, h).rg);
+    vec4 whole = decodeAccumulator(imageLoad(accum, ivec3(h.xy * halfStride, h.z)).rg);
+    vec4 odd = decodeAccumulator(imageLoad(halfAccum, h).rg);
     float evenWeight = whole.a - odd.a;
-    // both halves need weight; the whole's fp16 W rounds, so ask for a margin
+    // both halves need weight; the whole's W rounds (7 bits), so ask for a margin
     if (odd.a <= 0.0 || evenWeight <= 0.02 * whole.a) {
         imageStore(target, h, vec4(0.0));
         return;

@@ -23,7 +23,7 @@ void main() {
     // underflowed, and a texel that then missed a round (no own surface in
     // its pixel) lost its light for a bounce, which held the rho 0.99 furnace
     // at 46 instead of 73 after 256 directions.
-    float w = max(factor * halfToFloat(p.y >> 16u), SAMPLED_MIN_WEIGHT);
+    float w = max(factor * decodeAccumulatorWeight(p.y >> 21u), SAMPLED_MIN_WEIGHT);
     uint h = pcgHash(randomSeed ^ pcgHash(uint(t.x) | (uint(t.y) << 16u)) ^ pcgHash(uint(t.z) + 104729u));
-    imageStore(accum, t, uvec4(p.x, (p.y & 0xFFFFu) | (floatToHalf(w, uniform01(h)) << 16u), 0u, 0u));
+    imageStore(accum, t, uvec4(p.x, (p.y & 0x1FFFFFu) | (encodeAccumulatorWeight(w, uniform01(h)) << 21u), 0u, 0u));
 }

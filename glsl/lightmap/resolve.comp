@@ -28,7 +28,7 @@ void main() {
         imageStore(target, g, vec4(0.0));
         return;
     }
-    uvec2 p = imageLoad(accum, s).rg;
-    vec3 l = halfToFloat(p.y >> 16u) > 0.0 ? vec3(halfToFloat(p.x), halfToFloat(p.x >> 16u), halfToFloat(p.y)) : vec3(0.0);
+    vec4 state = decodeAccumulator(imageLoad(accum, s).rg);
+    vec3 l = state.a > 0.0 ? state.rgb : vec3(0.0);
     imageStore(target, g, vec4((l + imageLoad(directMap, s).rgb) * radianceUnit, 1.0));
 }

@@ -9,10 +9,13 @@
 // - when invalid samples (below) are skipped, dividing by the weight kept
 //   (not the count) keeps steep samples from being overweighted; the result
 //   is still biased where the skipped grazing light differs from the rest;
-// - the fp16 value stays near L_lm instead of growing with N, so the
+// - the stored value stays near L_lm instead of growing with N, so the
 //   stochastic rounding noise of each update stays small (an fp16 sum past
 //   2048 samples rounds by more than a sample is worth: 1.2 % rms per texel
-//   at 4096 directions in the furnace, against 0.03 % for the mean).
+//   at 4096 directions in the furnace, against 0.03 % for the mean). The
+//   mean is kept to 16 bits (lib/rounding.glsl, encodeAccumulator): in fp16
+//   its rounding noise still grew like sqrt(N), 1.3 % after 4096 samples
+//   where L_in varies as much as the mean.
 //
 // Double-sided triangles (BACK_SIDES): the walk also takes the
 // nearest node the other way, which the texel's back side sees, into the back
@@ -113,16 +116,15 @@ vec3 incomingRadiance(uint i, uint seen, vec3 look) {
     return (nodes[i].depth & seen) != 0u ? decodeRgbe(nodes[i].radiance) : vec3(0.0);
 }
 
-// `stored` (fp16 running mean M, weight W) with L_in folded in at weight w:
-// W += w, M += (L_in - M) w / W, rounded with the random numbers of h.
+// `stored` (running mean M, weight W; lib/rounding.glsl's accumulator) with
+// L_in folded in at weight w: W += w, M += (L_in - M) w / W, rounded with the
+// random numbers of h.
 uvec2 foldSample(uvec2 stored, vec3 incoming, float w, uint h) {
-    vec4 state = vec4(halfToFloat(stored.x), halfToFloat(stored.x >> 16u), halfToFloat(stored.y),
-                      halfToFloat(stored.y >> 16u));
+    vec4 state = decodeAccumulator(stored);
     float total = state.a + w;
     vec4 sum = vec4(state.rgb + (incoming - state.rgb) * (w / total), total);
     uint h1 = pcgHash(h), h2 = pcgHash(h1), h3 = pcgHash(h2);
-    return uvec2(floatToHalf(sum.r, uniform01(h)) | (floatToHalf(sum.g, uniform01(h1)) << 16u),
-                 floatToHalf(sum.b, uniform01(h2)) | (floatToHalf(sum.a, uniform01(h3)) << 16u));
+    return encodeAccumulator(sum, vec4(uniform01(h), uniform01(h1), uniform01(h2), uniform01(h3)));
 }
 #endif
 

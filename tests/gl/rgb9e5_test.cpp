@@ -142,5 +142,54 @@ TEST(Rgbe, GpuEncoderGivesTheCppTwinsBitsOnEveryInput) {
     EXPECT_EQ(mismatches, 0) << "of " << n << " inputs";
 }
 
+TEST(Accumulator, GpuEncoderGivesTheCppTwinsBitsOnEveryInput) {
+    BB_REQUIRE_GL();
+    const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+    std::vector<glm::vec4> values, us;
+    const float specials[] = {0.0f, -0.0f, -1.0f, nan, inf, -inf, 1e-30f, 3e-10f, 6.103515625e-5f, 1.0f,
+                              1.0f - 0x1p-20f, 0.5f, 65535.0f, 65535.9f, 70000.0f, 64512.0f, 65504.0f, 1e6f, 0.1f};
+    for (float a : specials)
+        for (float b : {0.0f, 1.0f, a, nan, inf})
+            for (float u : {0.0f, 0.5f, 0.999f}) {
+                values.push_back(glm::vec4(a, b, 0.25f * a, b));
+                us.push_back(glm::vec4(u, 1.0f - u, 0.5f, u));
+            }
+    // ordinary values, mantissas near the rounding carry, random u
+    for (int i = 0; i < 2000; ++i) {
+        const float x = std::ldexp(1.0f + float(i % 97) / 97.0f, i % 50 - 30);
+        values.push_back(glm::vec4(x, x * 0.999f, x * float(i % 13) / 13.0f, std::ldexp(1.0f - float(i % 7) / 1000.0f, i % 40 - 20)));
+        us.push_back(glm::vec4(float(i % 101) / 101.0f, float(i % 89) / 89.0f, float(i % 83) / 83.0f, float(i % 79) / 79.0f));
+    }
+    auto program = gl::buildProgram({"test/accumulator.comp"});
+    ASSERT_TRUE(program) << program.error();
+    const int n = int(values.size());
+    gl::Buffer bv = gl::Buffer::create("accumulator test values", int64_t(n) * 16, values.data(), 0);
+    gl::Buffer bu = gl::Buffer::create("accumulator test u", int64_t(n) * 16, us.data(), 0);
+    gl::Buffer bo = gl::Buffer::create("accumulator test out", int64_t(n) * 8, nullptr, 0);
+    gl::Buffer bd = gl::Buffer::create("accumulator test decoded", int64_t(n) * 16, nullptr, 0);
+    glUseProgram(program->id());
+    glUniform1i(program->uniform("count"), n);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, bv.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, bu.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, bo.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, bd.id());
+    glDispatchCompute(GLuint(n + 63) / 64, 1, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    std::vector<glm::uvec2> gpu(static_cast<size_t>(n));
+    std::vector<glm::vec4> decoded(static_cast<size_t>(n));
+    glGetNamedBufferSubData(bo.id(), 0, GLsizeiptr(n) * 8, gpu.data());
+    glGetNamedBufferSubData(bd.id(), 0, GLsizeiptr(n) * 16, decoded.data());
+    int mismatches = 0;
+    for (int i = 0; i < n; ++i) {
+        const glm::uvec2 cpu = encodeAccumulator(values[size_t(i)], Rounding::Stochastic, us[size_t(i)]);
+        const bool same = gpu[size_t(i)] == cpu && decoded[size_t(i)] == decodeAccumulator(cpu);
+        if (!same && ++mismatches <= 10)
+            ADD_FAILURE() << "input (" << values[size_t(i)].x << ", " << values[size_t(i)].y << ", " << values[size_t(i)].z
+                          << ", " << values[size_t(i)].w << "): GPU " << std::hex << gpu[size_t(i)].x << " "
+                          << gpu[size_t(i)].y << ", C++ " << cpu.x << " " << cpu.y;
+    }
+    EXPECT_EQ(mismatches, 0) << "of " << n << " inputs";
+}
+
 }  // namespace
 }  // namespace bb
