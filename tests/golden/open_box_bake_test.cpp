@@ -35,10 +35,14 @@
 // raises L_lm (interior floor texels get W = 0.9975, then 0.979, x sum |cos|
 // over the directions; a lone plane 1.0003).
 //
-// That bias is the price of no light through walls one texel thick
-// (thin_wall_bake_test.cpp) and is documented in docs/design-notes.md, so the
-// floor-mean tolerance is the measured bias plus 4 std of the average:
-// 2.5% + 1% = 3.5%. A bias beyond that (or a new one) still fails.
+// That bias was the price of no light through walls one texel thick
+// (thin_wall_bake_test.cpp), and the tolerance carried it (3.5 %), until a
+// grazing direction's sample stopped falling back to the footprint's own
+// point, whose pixel's ray passed up to half a pixel beside the texel, 1 / cos
+// of that along the floor (update.frag, footprintPixel: a Horvitz-Thompson
+// weight where the footprint projects to less than a pixel). The floor mean
+// read +1.71 % (adaptive tiling) and +1.80 % (uniform) before, -0.13 % and
+// +0.08 % after (2026-12-03). Tolerance now 4 std of the average: 1 %.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -70,7 +74,7 @@ void checkOpenBox(BakeOptions::Tiling tiling) {
 
     BB_REQUIRE_GL();
     const int res = 64, directions = 1024, bakes = 4;
-    const double floorTolerance = 0.035;  // known +2.5% skipping bias + 4 std (see the top)
+    const double floorTolerance = 0.01;  // 4 std of the average (see the top)
     // the average of `bakes` bakes with seeds 1..bakes
     LightmapPages maps;
     std::vector<int> owner;
@@ -124,8 +128,8 @@ void checkOpenBox(BakeOptions::Tiling tiling) {
                 100 * (floorMean / floorMeanExpected - 1));
     EXPECT_NEAR(floorMean, floorMeanExpected, floorTolerance * floorMeanExpected)
         << "the floor's mean L_lm (average of " << bakes << " bakes) is " << 100 * (floorMean / floorMeanExpected - 1)
-        << "% off the mean sky view factor of its texels (noise std 0.26%): a bias, e.g. grazing samples skipped as "
-           "invalid (they see the black walls)";
+        << "% off the mean sky view factor of its texels (noise std 0.26%): a bias, e.g. grazing samples skipped or "
+           "read beside the texel (they see the black walls)";
 
     for (const Probe& p : probes) {
         int x = int(std::floor(p.u * res)), y = int(std::floor(p.v * res));
