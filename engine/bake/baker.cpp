@@ -124,7 +124,8 @@ nlohmann::json BakeStats::toJson() const {
                    {"by_category", categories},
                    {"node_capacity", nodeCapacity}, {"peak_nodes_per_tile", peakNodesPerTile},
                    {"node_buffer_bytes", nodeBufferBytes}, {"head_image_bytes", headImageBytes}, {"bytes_per_node", 12}};
-    j["lightmap"] = {{"texels", lightmapTexels}, {"covered_texels", coveredTexels}, {"shared_texels", sharedTexels}};
+    j["lightmap"] = {{"texels", lightmapTexels}, {"covered_texels", coveredTexels}, {"shared_texels", sharedTexels},
+                   {"curved_texels", curvedTexels}};
     j["direct_light"] = {{"explicit_emitters", explicitEmitters}, {"emitter_samples", emitterSampleCount}};
     double bundleSeconds = secondsBundle > 0 ? secondsBundle : 1e-9;
     double updateSeconds = secondsUpdate > 0 ? secondsUpdate : 1e-9;
@@ -152,6 +153,9 @@ Status Baker::Impl::buildPrograms() {
     } specs[] = {
         {&updateProgram, {"lightmap/update.vert", "lightmap/update.frag"}, rounding + backSidesDefine()},
         {&sunProgram, {"lightmap/update.vert", "lightmap/update.frag"}, "#define SUN_PASS 1\n"},
+        {&updateCurvedProgram, {"lightmap/curved.vert", "lightmap/update.frag"},
+         rounding + backSidesDefine() + "#define CURVED_FOOTPRINT 1\n"},
+        {&sunCurvedProgram, {"lightmap/curved.vert", "lightmap/update.frag"}, "#define SUN_PASS 1\n#define CURVED_FOOTPRINT 1\n"},
         {&resolveProgram, {"lightmap/resolve.comp"}, ""},
         {&rescaleProgram, {"lightmap/rescale.comp"}, rounding},
         {&noiseProgram, {"lightmap/noise.comp"}, ""},
@@ -177,7 +181,7 @@ void Baker::Impl::uploadMesh() {
     MemoryCategory category("mesh");
     charts = findLightmapCharts(mesh);
     for (size_t t = 0; t < mesh.triangles.size(); ++t)
-        mesh.triangles[t].flags |= (charts[t] & 0xffffu) << TRIANGLE_CHART_SHIFT;
+        mesh.triangles[t].flags |= (charts[t] & TEXEL_CHART_MASK) << TRIANGLE_CHART_SHIFT;
     vertexBuffer = gl::Buffer::create("bake vertices", int64_t(mesh.vertices.size() * sizeof(BakeVertex)),
                                       mesh.vertices.data(), 0);
     triangleBuffer = gl::Buffer::create("bake triangles", int64_t(mesh.triangles.size() * sizeof(BakeTriangle)),
@@ -294,13 +298,18 @@ void Baker::Impl::coveragePass() {
     const int radius = std::min(std::max(layout.padding, 1) + 1, DILATION_RADIUS);
     std::vector<uint8_t> codes(size_t(res) * res), neighbours(codes.size());
     std::vector<uint16_t> ownerCharts(codes.size());
+    std::vector<std::vector<CurvedTexel>> curved(size_t(layout.pageCount));
+    std::vector<std::vector<int32_t>> pageOwners(size_t(layout.pageCount));
     for (int p = 0; p < layout.pageCount; ++p) {
         gl::readTexture(dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, codes.data());
         stats.coveredTexels += std::count(codes.begin(), codes.end(), uint8_t(DILATION_SELF));
-        const std::vector<int32_t> owners = texelOwners(mesh, p, res);
+        const std::vector<int32_t>& owners = pageOwners[size_t(p)] = texelOwners(mesh, p, res);
         chartNeighbourBits(codes, owners, charts, res, neighbours);
+        curved[size_t(p)] = curvedTexels(mesh, p, res, owners, charts);
+        std::erase_if(curved[size_t(p)], [&](const CurvedTexel& c) { return codes[c.texel] != DILATION_SELF; });
         for (size_t i = 0; i < owners.size(); ++i)
-            ownerCharts[i] = uint16_t(owners[i] < 0 ? 0xffffu : charts[size_t(owners[i])] & 0xffffu);
+            ownerCharts[i] = uint16_t(owners[i] < 0 ? TEXEL_CHART_MASK : charts[size_t(owners[i])] & TEXEL_CHART_MASK);
+        for (const CurvedTexel& c : curved[size_t(p)]) ownerCharts[c.texel] |= TEXEL_CURVED;
         gl::writeTexture(texelCharts.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_SHORT, 2, ownerCharts.data());
         const std::vector<uint64_t> masks = footprintMasks(mesh, p, res, owners, charts);
         stats.sharedTexels += int64_t(sharedTexels(mesh, p, res, owners, charts));
@@ -310,12 +319,28 @@ void Baker::Impl::coveragePass() {
         dilationCodes(codes, res, radius);
         gl::writeTexture(dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, codes.data());
     }
+    uploadCurvedTexels(curved, pageOwners);
     stats.lightmapTexels = int64_t(res) * res * layout.pageCount;
     if (stats.sharedTexels * 100 > stats.coveredTexels)  // over 1 %: worth the user's look
         logWarning(std::to_string(stats.sharedTexels) + " of " + std::to_string(stats.coveredTexels) +
                    " covered light map texels also hold part of another chart (TEXCOORD_1 charts closer than a texel "
                    "at this density): their light bleeds between the charts; raise --resolution or --texel-density, "
                    "or space the charts further apart");
+}
+
+void Baker::Impl::uploadCurvedTexels(const std::vector<std::vector<CurvedTexel>>& pages,
+                                     const std::vector<std::vector<int32_t>>& owners) {
+    MemoryCategory category("light maps");
+    CurvedFootprints curved = buildCurvedFootprints(mesh, clusters, layout.resolution, pages, owners);
+    stats.curvedTexels = int64_t(curved.count());
+    if (curved.count() == 0) return;
+    curvedTexelBuffer = gl::Buffer::create("curved texels", int64_t(curved.texels.size() * sizeof(glm::uvec4)),
+                                           curved.texels.data(), 0);
+    curvedRefBuffer = gl::Buffer::create("curved texels' triangles", int64_t(curved.refs.size() * 4), curved.refs.data(), 0);
+    curvedTriangleBuffer = gl::Buffer::create("curved triangles", int64_t(curved.triangles.size() * sizeof(CurvedTriangle)),
+                                              curved.triangles.data(), 0);
+    curvedClusterFirst = std::move(curved.clusterFirst);
+    stats.lightmapStateBytes += curved.bytes();
 }
 
 void Baker::Impl::sanitizeInputs(const Scene& scene) {
@@ -528,6 +553,12 @@ Status Baker::Impl::init(const Scene& scene) {
         glTextureParameteri(envTexture.id(), GL_TEXTURE_WRAP_S, GL_REPEAT);
     }
 
+    // coverage, the footprints' cells and the curved texels (light map state: within the budget's fixed part)
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    coveragePass();
+
     // The budget: what the light maps, mesh and materials (all fixed by the
     // scene and layout) leave goes to the bundle pass's node buffer and head
     // image, within the GL limits. Tile limits are all read from GL: a leaf's
@@ -578,10 +609,8 @@ Status Baker::Impl::init(const Scene& scene) {
         tracer = std::move(t.value());
     }
 
-    glDisable(GL_DEPTH_TEST);
-    glDisable(GL_CULL_FACE);
-    glDisable(GL_BLEND);
-    coveragePass();
+    if (!curvedClusterFirst.empty())
+        tracer->setCurvedTexels(curvedTexelBuffer.id(), curvedRefBuffer.id(), curvedTriangleBuffer.id(), curvedClusterFirst);
     stats.secondsSetup = secondsSince(t0);
 
     // the direct light, summed in float in views of the accumulators and the
@@ -742,14 +771,14 @@ Baker::BundleCapture Baker::captureBundle(const glm::vec3& dir) {
     one.nodeCapacity = 1e300;
     one.maxTilePixels = m.gridSize;
     m.tracer->run(m.bundleFrame(cap.dir, glm::vec2(0.0f), true, m.pixelSize), one, 12345u, false,
-        [&](const TileFrame& f, uint32_t) -> GLuint {
+        [&](const TileFrame& f, uint32_t) {
             cap.u = f.u;
             cap.v = f.v;
             cap.origin = f.rootOrigin;
             cap.pixelSize = f.pixelSize;
             cap.width = f.window.width;
             cap.height = f.window.height;
-            return 0;  // no update
+            return BundleTracer::UpdatePrograms{};  // no update
         });
     cap.nodeCount = m.tracer->lastNodeCount();
     if (cap.width == 0) return cap;  // nothing drawn

@@ -113,6 +113,7 @@ struct BakeStats {
     int64_t lightmapTexels = 0;
     int64_t coveredTexels = 0;
     int64_t sharedTexels = 0;  // covered texels another chart also overlaps (layout/bake_mesh.h sharedTexels)
+    int64_t curvedTexels = 0;  // covered texels whose chart folds or curves within them (layout/bake_mesh.h curvedTexels)
     std::vector<double> predictedOverActual;  // per tile: predicted nodes / actual nodes
     std::vector<int> tilesPerDirection;
     std::vector<int> leavesPerDirection;

@@ -14,6 +14,7 @@
 
 #include "bake/baker.h"
 #include "bake/bundle_tracer.h"
+#include "bake/curved_footprints.h"
 #include "core/timer.h"
 #include "gl/objects.h"
 #include "tiler/tiler.h"
@@ -85,9 +86,13 @@ struct Baker::Impl {
     int halfWidth = 1;     // halfAccum's side: ceil(resolution / stride)
     gl::Texture envTexture;
     gl::Framebuffer pageFbo;
-    gl::Program updateProgram, sunProgram, resolveProgram, rescaleProgram, metaProgram, coverageProgram,
+    gl::Program updateProgram, sunProgram, updateCurvedProgram, sunCurvedProgram, resolveProgram, rescaleProgram, metaProgram, coverageProgram,
         dilateProgram, readModesProgram, directFoldProgram, distanceProgram, emitterProgram, emitterFoldProgram, punctualProgram,
         noiseProgram;
+    // curved texels (bake/curved_footprints.h): their records, and per cluster its first one
+    gl::Buffer curvedTexelBuffer, curvedRefBuffer, curvedTriangleBuffer;
+    std::vector<uint32_t> curvedClusterFirst;  // empty: none
+    size_t curvedTexelCount() const { return curvedClusterFirst.empty() ? 0 : curvedClusterFirst.back(); }
     gl::Buffer materialAlphaBuffer, alphaTexelBuffer;  // cut-outs (glsl/shared/material_layout.h; cutouts.cpp)
     std::vector<glm::vec3> textureMeans;  // mean linear RGB of each scene texture (explicit emitters)
     std::vector<gl::Texture> materialTextures;
@@ -118,6 +123,8 @@ struct Baker::Impl {
     // page and material, setting `page` and, if asked, the material's uniforms and textures.
     void drawSurface(GLuint program, bool materialUniforms);
     void coveragePass();
+    void uploadCurvedTexels(const std::vector<std::vector<CurvedTexel>>& pages,
+                            const std::vector<std::vector<int32_t>>& owners);
     void bakeSun();
     void foldDirect(bool perSample);
     bool useExplicitEmitters() const;

@@ -84,6 +84,38 @@ void BundleTracer::drawClusters(GLuint program, const std::vector<uint32_t>& ids
     if (recordStats_) (receiversOnly ? stats_->updateTrianglesDrawn : stats_->bundleTrianglesDrawn) += triangles;
 }
 
+void BundleTracer::setCurvedTexels(GLuint texels, GLuint refs, GLuint triangles, std::vector<uint32_t> clusterFirst) {
+    curvedTexels_ = texels;
+    curvedRefs_ = refs;
+    curvedTriangles_ = triangles;
+    curvedClusterFirst_ = std::move(clusterFirst);
+    if (!pointArray_) pointArray_ = gl::VertexArray::create("curved texels' points (no attributes)");
+}
+
+void BundleTracer::drawCurvedTexels(GLuint program, const std::vector<uint32_t>& ids) {
+    if (curvedClusterFirst_.empty()) return;
+    drawFirst_.clear();
+    drawCount_.clear();
+    for (uint32_t c : ids) {
+        const int32_t first = int32_t(curvedClusterFirst_[c]), count = int32_t(curvedClusterFirst_[c + 1]) - first;
+        if (count == 0) continue;
+        if (!drawFirst_.empty() && drawFirst_.back() + drawCount_.back() == first)
+            drawCount_.back() += count;
+        else {
+            drawFirst_.push_back(first);
+            drawCount_.push_back(count);
+        }
+    }
+    if (drawFirst_.empty()) return;
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_CURVED_TEXELS, curvedTexels_);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_CURVED_REFS, curvedRefs_);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_CURVED_TRIANGLES, curvedTriangles_);
+    glUniform1i(glGetUniformLocation(program, "pageResolution"), scene_.pageResolution);
+    glBindVertexArray(pointArray_.id());
+    glMultiDrawArrays(GL_POINTS, drawFirst_.data(), drawCount_.data(), GLsizei(drawFirst_.size()));
+    glBindVertexArray(scene_.vertexArray);
+}
+
 void BundleTracer::begin(const BundleFrame& frame, const TilerOptions& options, uint32_t seed, bool recordStats) {
     auto t0 = Clock::now();
     frame_ = frame;
@@ -202,13 +234,21 @@ void BundleTracer::next(const UpdateFn& update) {
         gl::DebugGroup group("update pass");
         glBindFramebuffer(GL_FRAMEBUFFER, scene_.pageFramebuffer);
         glViewport(0, 0, scene_.pageResolution, scene_.pageResolution);
-        if (GLuint program = update(f, count)) {
+        const UpdatePrograms programs = update(f, count);
+        glBindImageTexture(BINDING_HEADS, heads_.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
+        // the two draws update disjoint texels (update.frag leaves curved ones to the second)
+        for (GLuint program : {programs.triangles, programs.curved}) {
+            if (!program) continue;
+            glUseProgram(program);
             setFrameUniforms(program, f);
             glUniform1ui(glGetUniformLocation(program, "nodeCount"), count);
-            glBindImageTexture(BINDING_HEADS, heads_.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
-            drawClusters(program, tile.clusters, true);
-            glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+            if (program == programs.triangles)
+                drawClusters(program, tile.clusters, true);
+            else
+                drawCurvedTexels(program, tile.clusters);
         }
+        if (programs.triangles || programs.curved)
+            glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
         if (recordStats_) {
             glFinish();
             stats_->secondsUpdate += secondsSince(tu);

@@ -67,9 +67,19 @@ struct BundleLimits {
 
 class BundleTracer {
 public:
-    // Binds the update program, sets its uniforms (other than the frame's and
-    // the node count, which the tracer sets) and returns it; 0 skips the update.
-    using UpdateFn = std::function<GLuint(const TileFrame&, uint32_t nodeCount)>;
+    // The update's programs: over the tile's receiving clusters in light map
+    // space, and over their curved texels (setCurvedTexels; one point each).
+    // 0 skips that draw.
+    struct UpdatePrograms {
+        GLuint triangles = 0, curved = 0;
+    };
+    // Sets the update programs' uniforms (other than the frame's, the node
+    // count and pageResolution, which the tracer sets) and returns them.
+    using UpdateFn = std::function<UpdatePrograms(const TileFrame&, uint32_t nodeCount)>;
+
+    // Curved texels (bake/curved_footprints.h) for the updates: their records'
+    // SSBOs and, per cluster, its first texel (clusterFirst; empty: none).
+    void setCurvedTexels(GLuint texels, GLuint refs, GLuint triangles, std::vector<uint32_t> clusterFirst);
 
     // Both passes read the triangle and vertex buffers as SSBOs in chunks of
     // GL_MAX_SHADER_STORAGE_BLOCK_SIZE (MeshChunks, layout/bake_mesh_gl.h):
@@ -105,6 +115,7 @@ private:
     void ensureNodes(int64_t nodes);
     void ensureHeads(int side);
     void drawClusters(GLuint program, const std::vector<uint32_t>& ids, bool receiversOnly);
+    void drawCurvedTexels(GLuint program, const std::vector<uint32_t>& ids);
 
     BundleScene scene_;
     BundleLimits limits_;
@@ -117,6 +128,9 @@ private:
     int64_t nodeAllocated_ = 0;
     int headSide_ = 0;
     std::vector<int32_t> drawFirst_, drawCount_;  // scratch: multi-draw ranges
+    GLuint curvedTexels_ = 0, curvedRefs_ = 0, curvedTriangles_ = 0;
+    std::vector<uint32_t> curvedClusterFirst_;
+    gl::VertexArray pointArray_;  // no attributes: curved texels' points read their SSBO
 
     // the direction in progress
     BundleFrame frame_;

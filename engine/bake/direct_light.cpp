@@ -100,15 +100,17 @@ void Baker::Impl::bakeSun() {
     for (size_t li = 0; li < lights.size(); ++li) {
         const glm::vec3 irradiance = lights[li].irradiance / radianceUnit;
         uint32_t footprintSample = 0;  // the jitter's index: each one samples another point of every texel's footprint
-        const BundleTracer::UpdateFn update = [&](const TileFrame&, uint32_t) -> GLuint {
-            glUseProgram(sunProgram.id());
-            glUniform3fv(sunProgram.uniform("sunIrradiance"), 1, &irradiance.x);
-            glUniform1f(sunProgram.uniform("depthBias"), depthBias);
-            glUniform1ui(sunProgram.uniform("footprintSample"), footprintSample);
+        const BundleTracer::UpdateFn update = [&](const TileFrame&, uint32_t) {
+            for (const gl::Program* program : {&sunProgram, &sunCurvedProgram}) {
+                glUseProgram(program->id());
+                glUniform3fv(program->uniform("sunIrradiance"), 1, &irradiance.x);
+                glUniform1f(program->uniform("depthBias"), depthBias);
+                glUniform1ui(program->uniform("footprintSample"), footprintSample);
+            }
             glBindTextureUnit(BINDING_FOOTPRINT_CELLS, footprintCells.id());
             bindDirectSums(*this);
             glBindImageTexture(BINDING_DIRECT, direct.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA16F);
-            return sunProgram.id();
+            return BundleTracer::UpdatePrograms{sunProgram.id(), curvedTexelCount() ? sunCurvedProgram.id() : 0u};
         };
         for (int jy = 0; jy < j; ++jy)
             for (int jx = 0; jx < j; ++jx) {

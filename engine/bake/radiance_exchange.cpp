@@ -31,27 +31,29 @@ void Baker::Impl::beginDirection(int k) {
         sampleWeight = 1.0;
     }
     const uint32_t seed = pcgHash(uint32_t(options.seed) * 0x9E3779B1u ^ pcgHash(uint32_t(k)));
-    directionUpdate = [this, sampleWeight, seed, k](const TileFrame&, uint32_t) -> GLuint {
+    directionUpdate = [this, sampleWeight, seed, k](const TileFrame&, uint32_t) {
         const bool useEnv = bool(envTexture);
-        glUseProgram(updateProgram.id());
-        glUniform1f(updateProgram.uniform("sampleWeight"), float(sampleWeight));
-        // per direction, not per tile: each texel is updated once per direction, and tiles change with the budget
-        glUniform1ui(updateProgram.uniform("randomSeed"), seed);
         const glm::vec3 sky = options.sky / radianceUnit;
-        glUniform3fv(updateProgram.uniform("sky"), 1, &sky.x);
-        glUniform1i(updateProgram.uniform("useEnv"), useEnv);
-        // the noise estimate's halves: the odd directions are the second of the
-        // two independently rotated sets (bake/directions.h)
-        glUniform1i(updateProgram.uniform("oddDirection"), k % 2);
-        glUniform1i(updateProgram.uniform("halfStride"), stats.noiseStride);
-        glUniform1i(updateProgram.uniform("backLayerOffset"), backLayerOffset);
+        for (const gl::Program* program : {&updateProgram, &updateCurvedProgram}) {
+            glUseProgram(program->id());
+            glUniform1f(program->uniform("sampleWeight"), float(sampleWeight));
+            // per direction, not per tile: each texel is updated once per direction, and tiles change with the budget
+            glUniform1ui(program->uniform("randomSeed"), seed);
+            glUniform3fv(program->uniform("sky"), 1, &sky.x);
+            glUniform1i(program->uniform("useEnv"), useEnv);
+            // the noise estimate's halves: the odd directions are the second of the
+            // two independently rotated sets (bake/directions.h)
+            glUniform1i(program->uniform("oddDirection"), k % 2);
+            glUniform1i(program->uniform("halfStride"), stats.noiseStride);
+            glUniform1i(program->uniform("backLayerOffset"), backLayerOffset);
+            glUniform1f(program->uniform("depthBias"), depthBias);
+            glUniform1ui(program->uniform("footprintSample"), uint32_t(k));
+        }
         glBindImageTexture(BINDING_HALF_ACCUM, halfAccum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
-        glUniform1f(updateProgram.uniform("depthBias"), depthBias);
-        glUniform1ui(updateProgram.uniform("footprintSample"), uint32_t(k));
         glBindTextureUnit(BINDING_FOOTPRINT_CELLS, footprintCells.id());
         if (useEnv) glBindTextureUnit(BINDING_ENV, envTexture.id());
         glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
-        return updateProgram.id();
+        return BundleTracer::UpdatePrograms{updateProgram.id(), curvedTexelCount() ? updateCurvedProgram.id() : 0u};
     };
     // the grid's phase, random per direction: where the bundle grid beats against
     // the light map's texels, the pattern moves from direction to direction and

@@ -68,6 +68,16 @@ TexelRange texelsUnder(const glm::dvec2 (&q)[3], int res) {
             std::min(res - 1, int(std::floor(std::max({q[0].y, q[1].y, q[2].y}))))};
 }
 
+// Twice the signed area of a polygon (counter-clockwise positive), then halved.
+double polygonArea(const std::vector<glm::dvec2>& poly) {
+    double area2 = 0.0;
+    for (size_t k = 0; k < poly.size(); ++k) {
+        const glm::dvec2 &a = poly[k], &b = poly[(k + 1) % poly.size()];
+        area2 += a.x * b.y - a.y * b.x;
+    }
+    return 0.5 * area2;
+}
+
 }  // namespace
 
 std::vector<uint32_t> findLightmapCharts(const BakeMesh& mesh) {
@@ -205,6 +215,74 @@ std::vector<glm::dvec2> clipSquare(const glm::dvec2 (&tri)[3]) {
     return poly;
 }
 
+bool texelAffine(const BakeMesh& mesh, uint32_t t, int res, bool normals, TexelAffine& out) {
+    const BakeVertex* v = &mesh.vertices[3 * size_t(t)];
+    glm::dvec2 q[3];
+    glm::dvec3 a[3];
+    for (int k = 0; k < 3; ++k) {
+        q[k] = glm::dvec2(v[k].lightmapUv) * double(res);
+        a[k] = glm::dvec3(normals ? glm::vec3(v[k].normal) : glm::vec3(v[k].position));
+    }
+    const glm::dvec2 e1 = q[1] - q[0], e2 = q[2] - q[0];
+    const double det = e1.x * e2.y - e1.y * e2.x;
+    if (det == 0.0 || !std::isfinite(det)) return false;
+    // at(q) - at0 = (a1 - a0) s + (a2 - a0) r with (s, r) solving e1 s + e2 r = q - q0
+    const glm::dvec3 f1 = a[1] - a[0], f2 = a[2] - a[0];
+    out.q0 = q[0];
+    out.at0 = a[0];
+    out.dx = (f1 * e2.y - f2 * e1.y) / det;
+    out.dy = (f2 * e1.x - f1 * e2.x) / det;
+    return true;
+}
+
+std::vector<CurvedTexel> curvedTexels(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,
+                                      const std::vector<uint32_t>& chart, double departure) {
+    // (texel, triangle) for every triangle of a covered texel's chart overlapping its square with area
+    std::vector<std::pair<uint32_t, uint32_t>> overlaps;
+    for (uint32_t t = mesh.pageFirstTriangle[size_t(page)]; t < mesh.pageFirstTriangle[size_t(page) + 1]; ++t) {
+        glm::dvec2 q[3];
+        const double absArea = pageCorners(mesh, t, res, q);
+        if (absArea == 0.0 || !std::isfinite(absArea)) continue;
+        const TexelRange r = texelsUnder(q, res);
+        for (int y = r.y0; y <= r.y1; ++y)
+            for (int x = r.x0; x <= r.x1; ++x) {
+                const size_t i = size_t(y) * res + x;
+                if (owner[i] < 0 || chart[size_t(owner[i])] != chart[t]) continue;
+                const glm::dvec2 o(x, y);
+                const glm::dvec2 local[3] = {q[0] - o, q[1] - o, q[2] - o};
+                if (polygonArea(clipSquare(local)) > 0.0) overlaps.push_back({uint32_t(i), t});
+            }
+    }
+    std::sort(overlaps.begin(), overlaps.end());
+    std::vector<CurvedTexel> curved;
+    for (size_t begin = 0, end; begin < overlaps.size(); begin = end) {
+        const uint32_t i = overlaps[begin].first;
+        for (end = begin; end < overlaps.size() && overlaps[end].first == i;) ++end;
+        const uint32_t o = uint32_t(owner[i]);
+        TexelAffine own;
+        if (end - begin < 2 || !texelAffine(mesh, o, res, false, own)) continue;
+        const double texelSize = std::max(glm::length(own.dx), glm::length(own.dy));
+        const glm::dvec2 corner(double(i % uint32_t(res)), double(i / uint32_t(res)));
+        double worst = 0.0;
+        for (size_t k = begin; k < end && worst <= departure * texelSize; ++k) {
+            const uint32_t t = overlaps[k].second;
+            TexelAffine surface;
+            glm::dvec2 q[3];
+            pageCorners(mesh, t, res, q);
+            if (t == o || !texelAffine(mesh, t, res, false, surface)) continue;
+            const glm::dvec2 local[3] = {q[0] - corner, q[1] - corner, q[2] - corner};
+            for (const glm::dvec2& p : clipSquare(local))
+                worst = std::max(worst, glm::length(surface.at(corner + p) - own.at(corner + p)));
+        }
+        if (!(worst > departure * texelSize)) continue;
+        CurvedTexel texel{i, {o}};
+        for (size_t k = begin; k < end; ++k)
+            if (overlaps[k].second != o) texel.triangles.push_back(overlaps[k].second);
+        curved.push_back(std::move(texel));
+    }
+    return curved;
+}
+
 size_t sharedTexels(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,
                     const std::vector<uint32_t>& chart) {
     std::vector<uint8_t> shared(size_t(res) * res, 0);
@@ -217,13 +295,7 @@ size_t sharedTexels(const BakeMesh& mesh, int page, int res, const std::vector<i
         auto overlaps = [&](int x, int y) {
             const glm::dvec2 o(x, y);
             const glm::dvec2 local[3] = {q[0] - o, q[1] - o, q[2] - o};
-            const std::vector<glm::dvec2> poly = clipSquare(local);
-            double area2 = 0.0;
-            for (size_t k = 0; k < poly.size(); ++k) {
-                const glm::dvec2 &a = poly[k], &b = poly[(k + 1) % poly.size()];
-                area2 += a.x * b.y - a.y * b.x;
-            }
-            return area2 > 0.0;
+            return polygonArea(clipSquare(local)) > 0.0;
         };
         const TexelRange r = texelsUnder(q, res);
         for (int y = r.y0; y <= r.y1; ++y)

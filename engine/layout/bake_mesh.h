@@ -84,6 +84,34 @@ std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res);
 std::vector<uint64_t> footprintMasks(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,
                                      const std::vector<uint32_t>& chart);
 
+// A texel whose footprint its owner's plane does not hold: its chart folds or
+// curves within its square (a chair's piping, a box's edge), so a point of the
+// square moved along the owner triangle's plane (lib/texel_footprint.glsl)
+// would leave the surface by more than `departure` texels. Its samples find
+// their point on the triangle that holds it instead (lib/curved_footprint.glsl).
+struct CurvedTexel {
+    uint32_t texel = 0;               // y * res + x
+    std::vector<uint32_t> triangles;  // the owner's chart's triangles overlapping its square with area, owner first
+};
+
+// The page's curved texels in texel order: of each covered texel, the part of
+// its square on its owner's chart (clipSquare) mapped through each of the
+// chart's triangles, against the same points on the owner's plane extended;
+// departures measured in the owner's texel size (the longer of its per-texel
+// steps along x and y).
+std::vector<CurvedTexel> curvedTexels(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,
+                                      const std::vector<uint32_t>& chart, double departure = 0.02);
+
+// Triangle t's position (normal) as an affine function of page texel
+// coordinates: at(q) = at0 + dx * (q.x - q0.x) + dy * (q.y - q0.y). False where
+// its light map triangle has no area.
+struct TexelAffine {
+    glm::dvec2 q0{0.0};
+    glm::dvec3 at0{0.0}, dx{0.0}, dy{0.0};
+    glm::dvec3 at(glm::dvec2 q) const { return at0 + dx * (q.x - q0.x) + dy * (q.y - q0.y); }
+};
+bool texelAffine(const BakeMesh& mesh, uint32_t t, int res, bool normals, TexelAffine& out);
+
 // The unit square clipped to a counter-clockwise triangle (Sutherland-Hodgman):
 // the part of a texel's square (triangle in that texel's coordinates) on it.
 std::vector<glm::dvec2> clipSquare(const glm::dvec2 (&tri)[3]);

@@ -63,7 +63,7 @@ vec3 axisOffset(uint mode, vec3 l, vec3 m, vec3 r, float x) {
 // wall's seen on the sill beside it), then the nearest of the three next to c
 // toward t that the fragment's own chart owns; c where none is.
 ivec2 ownTexel(vec2 t, ivec2 c, ivec2 size, int page, uint chart) {
-    if (texelFetch(texelCharts, ivec3(c, page), 0).r == chart) return c;
+    if ((texelFetch(texelCharts, ivec3(c, page), 0).r & TEXEL_CHART_MASK) == chart) return c;
     vec2 f = t - vec2(c);
     ivec2 toward = ivec2(f.x < 0.0 ? -1 : 1, f.y < 0.0 ? -1 : 1);
     bool alongX = abs(f.x) >= abs(f.y);  // the step along x brings the centre nearer than along y
@@ -71,7 +71,7 @@ ivec2 ownTexel(vec2 t, ivec2 c, ivec2 size, int page, uint chart) {
                               alongX ? ivec2(0, toward.y) : ivec2(toward.x, 0), toward);
     for (int k = 0; k < 3; ++k) {
         ivec2 n = clamp(c + order[k], ivec2(0), size - 1);
-        if (texelFetch(texelCharts, ivec3(n, page), 0).r == chart) return n;
+        if ((texelFetch(texelCharts, ivec3(n, page), 0).r & TEXEL_CHART_MASK) == chart) return n;
     }
     return c;
 }

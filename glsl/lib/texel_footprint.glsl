@@ -18,6 +18,15 @@
 //
 // Needs lib/rounding.glsl (pcgHash, uniform01) and shared/mesh_layout.h.
 
+// Whether the eighth-texel cell of `offset` (texels from the centre) touches
+// the chart (`cells`, as offChart's).
+bool cellOnChart(uvec2 cells, vec2 offset) {
+    ivec2 cell = clamp(ivec2(floor((offset + 0.5) * 8.0)), ivec2(0), ivec2(7));
+    uint bit = uint(cell.y * 8 + cell.x);
+    uint word = bit < 32u ? cells.x : cells.y;
+    return (word & (1u << (bit & 31u))) != 0u;
+}
+
 // Whether the point `offset` texels from the fragment's centre lies off its
 // chart: past an edge of the fragment's triangle that is a chart border
 // (exact), or in an eighth-texel cell of the square no part of the chart
@@ -29,22 +38,28 @@
 bool offChart(vec3 bary, vec3 baryDx, vec3 baryDy, uint flags, uvec2 cells, vec2 offset) {
     uint borders = (flags / TRIANGLE_CHART_BORDER0) & 7u;
     vec3 b = bary + baryDx * offset.x + baryDy * offset.y;
-    ivec2 cell = clamp(ivec2(floor((offset + 0.5) * 8.0)), ivec2(0), ivec2(7));
-    uint bit = uint(cell.y * 8 + cell.x);
-    uint word = bit < 32u ? cells.x : cells.y;
     return ((borders & 1u) != 0u && b.x < 0.0) || ((borders & 2u) != 0u && b.y < 0.0) ||
-           ((borders & 4u) != 0u && b.z < 0.0) || (word & (1u << (bit & 31u))) == 0u;
+           ((borders & 4u) != 0u && b.z < 0.0) || !cellOnChart(cells, offset);
+}
+
+// Candidate `attempt` of sample `sampleIndex`'s point, in texels from the
+// centre, each coordinate in [-0.5, 0.5): attempt 0 is point sampleIndex of
+// R2, the others hashed (uniform).
+vec2 footprintCandidate(uint sampleIndex, int attempt) {
+    if (attempt == 0) {
+        // R2 in 32-bit fixed point (alpha * 2^32, wrapping: exact for any index), from 0.5
+        uvec2 fixedPoint = uvec2(sampleIndex * 3242174889u, sampleIndex * 2447445413u) + 0x80000000u;
+        return vec2(fixedPoint >> 8u) * (1.0 / 16777216.0) - 0.5;
+    }
+    uint h = pcgHash(sampleIndex * 8u + uint(attempt - 1));
+    return vec2(uniform01(h), uniform01(pcgHash(h))) - 0.5;
 }
 
 // Offset in texels of sample `sampleIndex`'s point, each coordinate in [-0.5, 0.5).
 vec2 footprintOffset(vec3 bary, vec3 baryDx, vec3 baryDy, uint flags, uvec2 cells, uint sampleIndex) {
-    // R2 in 32-bit fixed point (alpha * 2^32, wrapping: exact for any index), from 0.5
-    uvec2 fixedPoint = uvec2(sampleIndex * 3242174889u, sampleIndex * 2447445413u) + 0x80000000u;
-    vec2 offset = vec2(fixedPoint >> 8u) * (1.0 / 16777216.0) - 0.5;
     for (int attempt = 0; attempt < 8; ++attempt) {
+        vec2 offset = footprintCandidate(sampleIndex, attempt);
         if (!offChart(bary, baryDx, baryDy, flags, cells, offset)) return offset;
-        uint h = pcgHash(sampleIndex * 8u + uint(attempt));
-        offset = vec2(uniform01(h), uniform01(pcgHash(h))) - 0.5;
     }
     return vec2(0.0);
 }

@@ -31,11 +31,18 @@
 #include "lib/bundle_frame.glsl"
 #include "lib/texel_footprint.glsl"
 
+#ifdef CURVED_FOOTPRINT
+// a curved texel (lib/curved_footprint.glsl; lightmap/curved.vert draws one point each)
+flat in uint vCurved;
+#else
 in vec3 vPosition;
 in vec3 vNormal;
 in vec3 vBary;
 flat in uint vFlags;
 flat in uint vPage;
+// bit TEXEL_CURVED: the curved texels' draw takes the texel's samples
+layout(binding = BINDING_TEXEL_CHARTS) uniform usampler2DArray texelCharts;
+#endif
 
 layout(binding = BINDING_HEADS, r32ui) uniform readonly uimage2D heads;
 layout(std430, binding = BINDING_NODES) readonly buffer Nodes { Node nodes[]; };
@@ -62,6 +69,9 @@ uniform uint nodeCount;      // nodes in this tile's lists (END_OF_LIST is large
 uniform float depthBias;      // scene units: float precision floor
 uniform uint footprintSample; // this pass's sample of each texel's footprint (the direction's, the sun jitter's index)
 layout(binding = BINDING_FOOTPRINT_CELLS) uniform usampler2DArray footprintCells;
+#ifdef CURVED_FOOTPRINT
+#include "lib/curved_footprint.glsl"
+#endif
 
 const float PI = 3.14159265358979;
 
@@ -130,9 +140,11 @@ uvec2 foldSample(uvec2 stored, vec3 incoming, float w, uint h) {
 
 // The texel's own surface at this sample (main): the sample's point, its
 // depth along d, the triangle's plane (normal ng, ng . d = cg), the texel's
-// size, the surface's curvature and the node flag of the side it looks to.
+// size, the surface's curvature, the node flag of the side it looks to and
+// where the plane is exact (the fragment's point; the curved texels' sample's).
 struct OwnSurface {
     vec3 position;
+    vec3 anchor;
     float depth;
     vec3 ng;
     float cg;
@@ -165,7 +177,7 @@ float ownCrossing(OwnSurface own, ivec2 pixel, vec2 offset) {
     // their own fragments are mostly another facet's); the curvature from the
     // shading normals' change across the texel (0 on flat charts, where the
     // tolerance stays tight).
-    float r = distance(crossing, vPosition);
+    float r = distance(crossing, own.anchor);
     float tolerance = 0.05 * pixelSize + depthBias + 1e-5 * abs(planeDepth) +
                       min(0.5 * own.curvature * r * r / abs(own.cg), 0.5 * own.texelSize);
     float self = NO_CROSSING, selfDistance = 3.0e38;
@@ -236,7 +248,54 @@ bool footprintPixel(vec2 centre, vec3 positionDx, vec3 positionDy, vec3 bary, ve
     return found;
 }
 
-void main() {
+// One sample of a texel for this pass: its footprint point, the shading
+// normal there, its triangle's plane (ng: the side the bundle pass gives the
+// triangle's fragments, lib/triangle_side.glsl), the texel's size on the
+// surface, the surface's curvature, the triangle's flags and the sample's
+// footprint weight (footprintPixel).
+struct TexelSample {
+    ivec3 texel;
+    vec3 position;
+    vec3 anchor;  // where ng's plane is exact (OwnSurface)
+    vec3 n;
+    vec3 ng;
+    float texelSize;
+    float curvature;
+    uint flags;
+    float weight;
+};
+
+#ifdef CURVED_FOOTPRINT
+// A curved texel's sample: its point on the triangle that holds it
+// (curvedFootprintPoint), read along the ray of the pixel it lies in: the
+// pixel-centre crossings of footprintPixel assume one plane over the square.
+// False: another leaf's.
+bool curvedSample(out TexelSample s) {
+    uvec4 head = curvedTexels[2u * vCurved];
+    s.texel = ivec3(ivec2(gl_FragCoord.xy), int(head.y));
+    // the leaf of the texel's centre takes its sample, as on flat texels
+    vec3 centre = uintBitsToFloat(curvedTexels[2u * vCurved + 1u].xyz);
+    if (!leafOwns(rootFromBundle(bundleFromWorld(centre).xy))) return false;
+    vec2 point;
+    CurvedTriangle tri;
+    curvedFootprintPoint(vCurved, texelFetch(footprintCells, s.texel, 0).rg, footprintSample, point, tri);
+    vec2 q = point - tri.corners01.xy;
+    s.position = tri.position.xyz + tri.positionDx.xyz * q.x + tri.positionDy.xyz * q.y;
+    s.anchor = s.position;
+    s.n = normalize(tri.normal.xyz + tri.normalDx.xyz * q.x + tri.normalDy.xyz * q.y);
+    s.ng = tri.faceNormal.xyz;
+    s.texelSize = max(length(tri.positionDx.xyz), length(tri.positionDy.xyz));
+    s.curvature = tri.corner2.w;
+    s.flags = floatBitsToUint(tri.corner2.z);
+    s.weight = 1.0;
+    return true;
+}
+#else
+// A light map fragment's sample: a point of the texel's footprint along the
+// triangle's own plane (lib/texel_footprint.glsl), at a pixel centre's
+// crossing where one is found (footprintPixel). False: no sample (a helper
+// lane, a curved texel, another leaf's, a grazing direction with no crossing).
+bool triangleSample(out TexelSample s) {
     // the triangle's own plane, from screen derivatives (before any return:
     // derivatives need the whole quad)
     vec3 positionDx = dFdx(vPosition), positionDy = dFdy(vPosition);
@@ -244,30 +303,30 @@ void main() {
     vec3 baryDx = dFdx(vBary), baryDy = dFdy(vBary);
     vec3 faceNormal = cross(positionDx, positionDy);
     // this texel's size on the surface (one step of the light map raster)
-    float texelSize = max(length(positionDx), length(positionDy));
+    s.texelSize = max(length(positionDx), length(positionDy));
     // llvmpipe runs helper lanes through the walk with undefined loads, where they
     // spin; they have no side effects to make, so leave at once (GLSL 4.50).
-    if (gl_HelperInvocation) return;
+    if (gl_HelperInvocation) return false;
     // this sample's point of the texel's footprint (lib/texel_footprint.glsl):
     // a texel half under a building reads half its outside value, as the
     // reference's does (the city under a sky: 6.6 % -> 5.3 % against it)
-    ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), int(vPage));
+    s.texel = ivec3(ivec2(gl_FragCoord.xy), int(vPage));
+    if ((texelFetch(texelCharts, s.texel, 0).r & TEXEL_CURVED) != 0u) return false;
     // the leaf of the texel's centre takes its sample (a sample whose point
     // lies in another leaf is lost, at random: leaves move with d)
     vec2 centreRoot = rootFromBundle(bundleFromWorld(vPosition).xy);
-    if (!leafOwns(centreRoot)) return;
+    if (!leafOwns(centreRoot)) return false;
 #ifdef SUN_PASS
     uint pixelSeed = pcgHash(footprintSample + 0x632be5abu);
 #else
     uint pixelSeed = pcgHash(randomSeed);
 #endif
     vec2 jitter;
-    float footprintWeight;
-    uvec2 cells = texelFetch(footprintCells, texel, 0).rg;
+    uvec2 cells = texelFetch(footprintCells, s.texel, 0).rg;
     if (!footprintPixel(gridFromRoot(centreRoot), positionDx, positionDy, vBary, baryDx, baryDy, vFlags, cells, pixelSeed,
-                        jitter, footprintWeight)) {
+                        jitter, s.weight)) {
 #ifndef SUN_PASS
-        if (footprintWeight == 0.0) return;  // a grazing direction no pixel centre crossed the footprint in
+        if (s.weight == 0.0) return false;  // a grazing direction no pixel centre crossed the footprint in
 #endif
         jitter = footprintOffset(vBary, baryDx, baryDy, vFlags, cells, footprintSample);
 #ifdef SUN_PASS
@@ -278,10 +337,11 @@ void main() {
         // along its border stays out of it. Where a pixel covers more than a
         // texel (a grazing sun), the pixel's jitter alone spreads the samples.
         float facing = length(faceNormal) > 0.0 ? abs(dot(normalize(faceNormal), bundleDir)) : 1.0;
-        jitter *= clamp(1.0 - pixelSize / (max(facing, 1e-3) * max(texelSize, 1e-30)), 0.0, 1.0);
+        jitter *= clamp(1.0 - pixelSize / (max(facing, 1e-3) * max(s.texelSize, 1e-30)), 0.0, 1.0);
 #endif
     }
-    vec3 position = vPosition + positionDx * jitter.x + positionDy * jitter.y;
+    s.position = vPosition + positionDx * jitter.x + positionDy * jitter.y;
+    s.anchor = vPosition;
     // the shading normal where the point leaves the triangle, not extrapolated
     // past it: a triangle far smaller than a texel (300 to a texel on the
     // chair of mixed_lighting) would swing it by tens of degrees
@@ -289,15 +349,29 @@ void main() {
     float inside = 1.0;
     for (int k = 0; k < 3; ++k)
         if (baryStep[k] < 0.0) inside = min(inside, max(vBary[k], 0.0) / -baryStep[k]);
-    vec3 n = normalize(vNormal + (normalDx * jitter.x + normalDy * jitter.y) * inside);
+    s.n = normalize(vNormal + (normalDx * jitter.x + normalDy * jitter.y) * inside);
     // the triangle's plane, on the side the bundle pass gives its fragments
     // (lib/triangle_side.glsl; the flag is computed with the mesh)
-    vec3 ng = n;
+    s.ng = s.n;
     if (length(faceNormal) > 0.0) {
-        ng = normalize(faceNormal);
-        if ((vFlags & TRIANGLE_DERIVATIVE_NORMAL_FLIPPED) != 0u) ng = -ng;
+        s.ng = normalize(faceNormal);
+        if ((vFlags & TRIANGLE_DERIVATIVE_NORMAL_FLIPPED) != 0u) s.ng = -s.ng;
     }
-    vec3 b = bundleFromWorld(position);
+    s.curvature = max(length(normalDx) / max(length(positionDx), 1e-30), length(normalDy) / max(length(positionDy), 1e-30));
+    s.flags = vFlags;
+    return true;
+}
+#endif
+
+void main() {
+    TexelSample s;
+#ifdef CURVED_FOOTPRINT
+    if (!curvedSample(s)) return;
+#else
+    if (!triangleSample(s)) return;
+#endif
+    ivec3 texel = s.texel;
+    vec3 b = bundleFromWorld(s.position);
     vec2 q = rootFromBundle(b.xy);
     if (!leafOwns(q)) return;  // another leaf's
     vec2 g = gridFromRoot(q);
@@ -307,10 +381,21 @@ void main() {
     // The side the texel looks to is its triangle's (ng, the side the bundle
     // pass gives the triangle's own fragments); its shading normal n weighs the
     // sample (cosine), and a direction below n's horizon adds nothing.
-    bool ahead = dot(ng, bundleDir) > 0.0;  // the texel looks along +d
-    float c = dot(n, bundleDir);
+    bool ahead = dot(s.ng, bundleDir) > 0.0;  // the texel looks along +d
+    float c = dot(s.n, bundleDir);
     float cosine = ahead ? c : -c;
+#ifdef SUN_PASS
+    // the sun pass's d is the light's travel direction: a texel facing the sun
+    // looks along -d. A flat texel facing away takes no sample (its count stays
+    // 0: no light); a curved texel's point facing away is one of its samples,
+    // dark, once its ray is found below like the lit ones'.
+    bool lit = !ahead && cosine > 0.0;
+#ifndef CURVED_FOOTPRINT
+    if (!lit) return;
+#endif
+#else
     if (cosine <= 0.0) return;
+#endif
     uint ownSide = ahead ? NODE_VISIBLE_FROM_AHEAD : NODE_VISIBLE_FROM_BEHIND;
     uint seenSide = ahead ? NODE_VISIBLE_FROM_BEHIND : NODE_VISIBLE_FROM_AHEAD;
     // The ray through the pixel centre passes beside the sample's point; find
@@ -325,13 +410,10 @@ void main() {
     // so weighs the rest too much (rel_rmse against the reference, 1024
     // directions: two rooms 1.09 -> 1.04 %, Cornell box 2.38 -> 2.26 %; the
     // update pass 5-15 % slower on the city). No crossing in any: skipped.
-    float cg = dot(ng, bundleDir);
+    float cg = dot(s.ng, bundleDir);
     if (abs(cg) < 1e-4) return;
     vec2 offset = (g - floor(g) - 0.5) * pixelSize;  // texel minus pixel centre, scene units
-    OwnSurface own = OwnSurface(position, b.z, ng, cg, texelSize,
-                                max(length(normalDx) / max(length(positionDx), 1e-30),
-                                    length(normalDy) / max(length(positionDy), 1e-30)),
-                                ownSide);
+    OwnSurface own = OwnSurface(s.position, s.anchor, b.z, s.ng, cg, s.texelSize, s.curvature, ownSide);
     float self = ownCrossing(own, pixel, offset);
     if (self == NO_CROSSING) {
         // the three on the point's side of the pixel's centre (toward sign(offset)): their rays pass nearer it
@@ -350,24 +432,22 @@ void main() {
     uint bestNode = nearestNode(pixel, start, ahead, seenSide);
 
 #ifdef SUN_PASS
-    // the sun pass's d is the light's travel direction: a texel facing the sun looks along -d
     // a valid sample: sums += lit irradiance * cos / pi, count += 1 (exact in fp16 to 2048)
-    if (ahead) return;
-    addDirect(texel, bestNode == END_OF_LIST ? sunIrradiance * cosine / PI : vec3(0.0));
+    addDirect(texel, lit && bestNode == END_OF_LIST ? sunIrradiance * cosine / PI : vec3(0.0));
     vec4 d = imageLoad(directMap, texel);
     imageStore(directMap, texel, vec4(d.rgb, d.a + 1.0));
 #else
     vec3 incoming = incomingRadiance(bestNode, seenSide, ahead ? bundleDir : -bundleDir);
     // the running cosine-weighted mean of L_in (rgb) and its weight W (a)
-    float w = sampleWeight * cosine * footprintWeight;
-    uint h = pcgHash(randomSeed ^ pcgHash(uint(texel.x) | (uint(texel.y) << 16u)) ^ pcgHash(vPage + 7919u));
+    float w = sampleWeight * cosine * s.weight;
+    uint h = pcgHash(randomSeed ^ pcgHash(uint(texel.x) | (uint(texel.y) << 16u)) ^ pcgHash(uint(texel.z) + 7919u));
     imageStore(accum, texel, uvec4(foldSample(imageLoad(accum, texel).rg, incoming, w, h), 0u, 0u));
 #ifdef BACK_SIDES
     // A double-sided triangle's back side: the nearest node the other way,
     // which it sees along the same line at the same cosine, into its own
     // accumulator (only built for scenes with back sides: llvmpipe runs the
     // loads of a branch no lane takes).
-    if ((vFlags & TRIANGLE_DOUBLE_SIDED) != 0u) {
+    if ((s.flags & TRIANGLE_DOUBLE_SIDED) != 0u) {
         uint bestBackNode = nearestNode(pixel, self + (ahead ? -depthBias : depthBias), !ahead, ownSide);
         ivec3 back = ivec3(texel.xy, texel.z + backLayerOffset);
         vec3 incomingBack = incomingRadiance(bestBackNode, ownSide, ahead ? -bundleDir : bundleDir);

@@ -31,6 +31,9 @@ struct Node {
 #define BINDING_NODES 0          // SSBO: Node nodes[]
 #define BINDING_NODE_COUNTER 0   // atomic counter: nodes appended
 #define BINDING_VERTICES 2       // SSBO: the bake vertices (BakeVertex, 48 bytes), read by the bundle pass
+#define BINDING_CURVED_TEXELS 3  // SSBO: curved texels (lib/curved_footprint.glsl), update and sun passes
+#define BINDING_CURVED_REFS 4    // SSBO: their triangles' indices
+#define BINDING_CURVED_TRIANGLES 7  // SSBO: CurvedTriangle curvedTriangles[]
 #define BINDING_HEADS 0          // image unit: r32ui head pointers of the tile
 #define BINDING_ACCUM 1          // image unit: rg32ui accumulators (packed fp16 RGB + W), array of pages
 #define BINDING_DIRECT 2         // image unit: rgba16f direct light L_lm (sun + emitters); a: the sun's sample count while it is baked
@@ -47,7 +50,7 @@ struct Node {
 #define BINDING_MATERIAL_TEX 2   // texture unit: a material's albedo texture (emission: + 1)
 #define BINDING_READ_MODES 4     // texture unit: r8ui per texel: READ_* per axis (lightmap/read_modes.comp)
 #define BINDING_FOOTPRINT_CELLS 5  // texture unit: rg32ui per texel: its square's 8 x 8 cells on its chart (footprintMasks)
-#define BINDING_TEXEL_CHARTS 6   // texture unit: r16ui per texel: its owner's chart, low 16 bits (TRIANGLE_CHART_SHIFT)
+#define BINDING_TEXEL_CHARTS 6   // texture unit: r16ui per texel: its owner's chart, low 15 bits, and TEXEL_CURVED (mesh_layout.h)
 #define BINDING_CHART_NEIGHBOURS_IMAGE 6  // image unit, read-modes pass only (the dilation's unit elsewhere)
 #define BINDING_READ_MODES_IMAGE 7        // image unit, read-modes pass only (the resolve target's unit elsewhere)
 

@@ -17,10 +17,17 @@
 // space. A texel's footprint ends there (lib/texel_footprint.glsl); across an
 // edge the chart shares, it goes on in the neighbour. Bit k: TRIANGLE_CHART_BORDER0 << k.
 #define TRIANGLE_CHART_BORDER0 16u
-// Bits 16-31: the low 16 bits of the triangle's light map chart
+// Bits 16-30: the low 15 bits of the triangle's light map chart
 // (findLightmapCharts), set by the baker for the bundle pass, which reads no
 // texel another chart owns (glsl/bundle/append.frag, texelCharts).
 #define TRIANGLE_CHART_SHIFT 16u
+// texelCharts (r16ui per texel): its owner's chart's low 15 bits
+// (TEXEL_CHART_MASK; uncovered: all of them set), and TEXEL_CURVED where its
+// chart folds or curves within its square (engine/layout/bake_mesh.h
+// curvedTexels): the update pass's light map raster leaves such texels to
+// the curved texels' draw (lib/curved_footprint.glsl).
+#define TEXEL_CHART_MASK 0x7fffu
+#define TEXEL_CURVED 0x8000u
 
 // SSBO binding of BakeTriangle triangles[] (lib/bake_vertex.glsl), bound in
 // chunks by MeshChunks (engine/layout/bake_mesh_gl.h)

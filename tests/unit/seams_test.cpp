@@ -66,6 +66,32 @@ TEST(Seams, ChartsCloserThanATexelKeepNoPairs) {
     EXPECT_EQ(s.narrowPairs, 17u);
 }
 
+// A chart folded along the quad's diagonal (the corner (0, 1) lifted off the
+// plane): the texels whose squares hold both triangles are curved (their
+// owner's plane extended over the square leaves the other triangle); the flat
+// quad, or one folded by less than the departure (2 % of a texel), has none.
+TEST(CurvedTexels, AFoldWithinATexelIsCurved) {
+    auto curved = [](float lift) {
+        BakeMesh m = quadMesh({0, 0});
+        m.vertices[5].position.z = lift;  // triangle 1's corner (0, 1)
+        const std::vector<int32_t> owners = texelOwners(m, 0, 16);
+        return curvedTexels(m, 0, 16, owners, findLightmapCharts(m));
+    };
+    EXPECT_TRUE(curved(0.0f).empty());
+    EXPECT_TRUE(curved(0.001f).empty());  // departs by at most ~0.1 % of a texel (0.25 units)
+    const std::vector<CurvedTexel> folded = curved(0.5f);
+    std::printf("[curved] %zu texels along a fold\n", folded.size());
+    // the diagonal's 4 texels (the 4 x 4 quad's) and those its squares' corners touch, less any
+    // the owner's plane extended still holds
+    EXPECT_GE(folded.size(), 4u);
+    EXPECT_LE(folded.size(), 10u);
+    for (const CurvedTexel& c : folded) {
+        const int x = int(c.texel % 16), y = int(c.texel / 16);
+        EXPECT_LE(std::abs(x - y), 1) << "texel (" << x << ", " << y << ") is off the fold";
+        EXPECT_EQ(c.triangles.size(), 2u);
+    }
+}
+
 // The same two charts' texels: a quarter texel apart, the texels along their
 // diagonal hold parts of both; half a page apart, none does.
 TEST(SharedTexels, CountsTexelsAnotherChartAlsoOverlaps) {

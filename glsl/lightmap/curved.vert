@@ -1,0 +1,20 @@
+#version 430
+// Update and sun passes on curved texels (lib/curved_footprint.glsl): one
+// point a texel, at its centre on its page, drawn in runs of the tile's
+// clusters (engine/bake/curved_footprints.h).
+#include "shared/bundle_layout.h"
+#include "shared/mesh_layout.h"
+#include "lib/rounding.glsl"
+#include "lib/texel_footprint.glsl"
+#include "lib/curved_footprint.glsl"
+
+uniform int pageResolution;
+flat out uint vCurved;
+
+void main() {
+    uint texelBits = curvedTexels[2u * uint(gl_VertexID)].x;
+    vec2 centre = vec2(texelBits & 0xffffu, texelBits >> 16u) + 0.5;
+    gl_Position = vec4(centre / float(pageResolution) * 2.0 - 1.0, 0.0, 1.0);
+    gl_PointSize = 1.0;
+    vCurved = uint(gl_VertexID);
+}
