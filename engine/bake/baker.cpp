@@ -166,8 +166,10 @@ Status Baker::Impl::buildPrograms() {
         {&directFoldProgram, {"lightmap/direct_fold.comp"}, rounding},
         {&distanceProgram, {"direct/distance.vert", "direct/distance.frag"}, ""},
         {&emitterProgram, {"direct/emitter.vert", "direct/emitter.frag"}, ""},
+        {&emitterCurvedProgram, {"lightmap/curved.vert", "direct/emitter.frag"}, "#define CURVED_FOOTPRINT 1\n"},
         {&emitterFoldProgram, {"direct/emitter_fold.comp"}, ""},
         {&punctualProgram, {"direct/emitter.vert", "direct/punctual.frag"}, ""},
+        {&punctualCurvedProgram, {"lightmap/curved.vert", "direct/punctual.frag"}, "#define CURVED_FOOTPRINT 1\n"},
     };
     for (auto& s : specs) {
         auto p = gl::buildProgram(s.files, s.defines);
@@ -340,7 +342,16 @@ void Baker::Impl::uploadCurvedTexels(const std::vector<std::vector<CurvedTexel>>
     curvedTriangleBuffer = gl::Buffer::create("curved triangles", int64_t(curved.triangles.size() * sizeof(CurvedTriangle)),
                                               curved.triangles.data(), 0);
     curvedClusterFirst = std::move(curved.clusterFirst);
+    pointArray = gl::VertexArray::create("curved texels' points (no attributes)");
     stats.lightmapStateBytes += curved.bytes();
+}
+
+void Baker::Impl::bindCurvedTexels(GLuint program) const {
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_CURVED_TEXELS, curvedTexelBuffer.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_CURVED_REFS, curvedRefBuffer.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_CURVED_TRIANGLES, curvedTriangleBuffer.id());
+    glUniform1i(glGetUniformLocation(program, "pageResolution"), layout.resolution);
+    glBindVertexArray(pointArray.id());
 }
 
 void Baker::Impl::sanitizeInputs(const Scene& scene) {
@@ -610,7 +621,7 @@ Status Baker::Impl::init(const Scene& scene) {
     }
 
     if (!curvedClusterFirst.empty())
-        tracer->setCurvedTexels(curvedTexelBuffer.id(), curvedRefBuffer.id(), curvedTriangleBuffer.id(), curvedClusterFirst);
+        tracer->setCurvedTexels(curvedClusterFirst, [this](GLuint program) { bindCurvedTexels(program); });
     stats.secondsSetup = secondsSince(t0);
 
     // the direct light, summed in float in views of the accumulators and the

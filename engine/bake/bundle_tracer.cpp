@@ -84,12 +84,9 @@ void BundleTracer::drawClusters(GLuint program, const std::vector<uint32_t>& ids
     if (recordStats_) (receiversOnly ? stats_->updateTrianglesDrawn : stats_->bundleTrianglesDrawn) += triangles;
 }
 
-void BundleTracer::setCurvedTexels(GLuint texels, GLuint refs, GLuint triangles, std::vector<uint32_t> clusterFirst) {
-    curvedTexels_ = texels;
-    curvedRefs_ = refs;
-    curvedTriangles_ = triangles;
+void BundleTracer::setCurvedTexels(std::vector<uint32_t> clusterFirst, std::function<void(GLuint)> bind) {
     curvedClusterFirst_ = std::move(clusterFirst);
-    if (!pointArray_) pointArray_ = gl::VertexArray::create("curved texels' points (no attributes)");
+    bindCurvedTexels_ = std::move(bind);
 }
 
 void BundleTracer::drawCurvedTexels(GLuint program, const std::vector<uint32_t>& ids) {
@@ -107,11 +104,7 @@ void BundleTracer::drawCurvedTexels(GLuint program, const std::vector<uint32_t>&
         }
     }
     if (drawFirst_.empty()) return;
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_CURVED_TEXELS, curvedTexels_);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_CURVED_REFS, curvedRefs_);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_CURVED_TRIANGLES, curvedTriangles_);
-    glUniform1i(glGetUniformLocation(program, "pageResolution"), scene_.pageResolution);
-    glBindVertexArray(pointArray_.id());
+    bindCurvedTexels_(program);
     glMultiDrawArrays(GL_POINTS, drawFirst_.data(), drawCount_.data(), GLsizei(drawFirst_.size()));
     glBindVertexArray(scene_.vertexArray);
 }

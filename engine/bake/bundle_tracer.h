@@ -77,9 +77,10 @@ public:
     // count and pageResolution, which the tracer sets) and returns them.
     using UpdateFn = std::function<UpdatePrograms(const TileFrame&, uint32_t nodeCount)>;
 
-    // Curved texels (bake/curved_footprints.h) for the updates: their records'
-    // SSBOs and, per cluster, its first texel (clusterFirst; empty: none).
-    void setCurvedTexels(GLuint texels, GLuint refs, GLuint triangles, std::vector<uint32_t> clusterFirst);
+    // Curved texels (bake/curved_footprints.h) for the updates: per cluster,
+    // its first texel (clusterFirst; empty: none), and what binds their
+    // records for a draw of their points with the program given.
+    void setCurvedTexels(std::vector<uint32_t> clusterFirst, std::function<void(GLuint)> bind);
 
     // Both passes read the triangle and vertex buffers as SSBOs in chunks of
     // GL_MAX_SHADER_STORAGE_BLOCK_SIZE (MeshChunks, layout/bake_mesh_gl.h):
@@ -128,9 +129,8 @@ private:
     int64_t nodeAllocated_ = 0;
     int headSide_ = 0;
     std::vector<int32_t> drawFirst_, drawCount_;  // scratch: multi-draw ranges
-    GLuint curvedTexels_ = 0, curvedRefs_ = 0, curvedTriangles_ = 0;
     std::vector<uint32_t> curvedClusterFirst_;
-    gl::VertexArray pointArray_;  // no attributes: curved texels' points read their SSBO
+    std::function<void(GLuint)> bindCurvedTexels_;
 
     // the direction in progress
     BundleFrame frame_;

@@ -1,6 +1,6 @@
 // Curved texels on the GPU (glsl/lib/curved_footprint.glsl): where a chart
 // folds or curves within a texel's square (layout/bake_mesh.h curvedTexels),
-// the update and sun passes draw the texel as a point and find each sample's
+// the light passes draw the texel as a point and find each sample's
 // footprint point on the triangle that holds it. GL-free.
 #pragma once
 

@@ -157,22 +157,36 @@ int shadowCubeSize(const Baker::Impl& m) {
 // One light's (an emitter sample's, a point or spot light's) irradiance times
 // the visibility `cube` holds, into the direct light's float sums: `program`
 // (its light uniforms set) over every page.
-void addVisibleLight(Baker::Impl& m, const gl::Program& program, const DistanceCube& cube) {
-    const float pixelSize = m.pixelSize;
-    // the visibility test's tolerance along the ray (lib/cube_visibility.glsl):
-    // half a bundle pixel, well under a texel so walls one texel thick still cast shadows
-    glUniform1f(program.uniform("rayOffset"), 0.5f * pixelSize);
-    glUniform1i(program.uniform("cubeSize"), cube.size);
-    glUniformMatrix3fv(program.uniform("cubeFromWorld"), 1, GL_FALSE, &cube.cubeFromWorld[0][0]);
+void addVisibleLight(Baker::Impl& m, const gl::Program& program, const gl::Program& curvedProgram,
+                     const DistanceCube& cube) {
+    for (const gl::Program* p : {&program, &curvedProgram}) {
+        glUseProgram(p->id());
+        // the visibility test's tolerance along the ray (lib/cube_visibility.glsl):
+        // half a bundle pixel, well under a texel so walls one texel thick still cast shadows
+        glUniform1f(p->uniform("rayOffset"), 0.5f * m.pixelSize);
+        glUniform1i(p->uniform("cubeSize"), cube.size);
+        glUniformMatrix3fv(p->uniform("cubeFromWorld"), 1, GL_FALSE, &cube.cubeFromWorld[0][0]);
+    }
     glBindTextureUnit(0, cube.cube.id());
+    glBindTextureUnit(BINDING_TEXEL_CHARTS, m.texelCharts.id());
+    glBindTextureUnit(BINDING_FOOTPRINT_CELLS, m.footprintCells.id());
     bindDirectSums(m);
     glBindFramebuffer(GL_FRAMEBUFFER, m.pageFbo.id());
     glViewport(0, 0, m.layout.resolution, m.layout.resolution);
+    glUseProgram(program.id());
+    glBindVertexArray(m.vao.id());
     const std::vector<uint32_t>& first = m.mesh.pageFirstTriangle;
     for (int page = 0; page < m.layout.pageCount; ++page) {
         glUniform1i(program.uniform("page"), page);
         const int64_t count = int64_t(first[page + 1]) - first[page];
         if (count) glDrawArrays(GL_TRIANGLES, drawFirstVertex(first[page]), GLsizei(count * 3));
+    }
+    // the curved texels, every page's (the draw above leaves them to this one)
+    if (m.curvedTexelCount()) {
+        glUseProgram(curvedProgram.id());
+        m.bindCurvedTexels(curvedProgram.id());
+        glDrawArrays(GL_POINTS, 0, GLsizei(m.curvedTexelCount()));
+        glBindVertexArray(m.vao.id());
     }
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
 }
@@ -213,7 +227,6 @@ void Baker::Impl::bakeEmitters() {
     const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     glClearTexImage(sums.id(), 0, GL_RGBA, GL_FLOAT, zero);
     glBindImageTexture(BINDING_EMITTER_SUMS, sums.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
-    glBindTextureUnit(BINDING_FOOTPRINT_CELLS, footprintCells.id());
 
     for (const Emitter& e : emitters) {
         const BakeVertex* v = &mesh.vertices[e.triangle * 3];
@@ -244,15 +257,17 @@ void Baker::Impl::bakeEmitters() {
             const glm::mat3 orientation(randomRotation(hash(options.seed, e.triangle, uint64_t(i) + (1ull << 32))));
             cube.render(vao.id(), distanceProgram, point, orientation, nearPlane, farPlane, uint32_t(e.triangle));
             // accumulate this sample's share into the direct map, page by page
-            glUseProgram(emitterProgram.id());
-            glUniform3fv(emitterProgram.uniform("emitterA"), 1, &a.x);
-            glUniform3fv(emitterProgram.uniform("emitterB"), 1, &b.x);
-            glUniform3fv(emitterProgram.uniform("emitterC"), 1, &c.x);
-            glUniform3fv(emitterProgram.uniform("emitterNormal"), 1, &n.x);
-            glUniform1i(emitterProgram.uniform("emitterDoubleSided"), doubleSided);
-            glUniform3fv(emitterProgram.uniform("samplePoint"), 1, &point.x);
-            glUniform1ui(emitterProgram.uniform("footprintSample"), uint32_t(stats.emitterSampleCount));
-            addVisibleLight(*this, emitterProgram, cube);
+            for (const gl::Program* p : {&emitterProgram, &emitterCurvedProgram}) {
+                glUseProgram(p->id());
+                glUniform3fv(p->uniform("emitterA"), 1, &a.x);
+                glUniform3fv(p->uniform("emitterB"), 1, &b.x);
+                glUniform3fv(p->uniform("emitterC"), 1, &c.x);
+                glUniform3fv(p->uniform("emitterNormal"), 1, &n.x);
+                glUniform1i(p->uniform("emitterDoubleSided"), doubleSided);
+                glUniform3fv(p->uniform("samplePoint"), 1, &point.x);
+                glUniform1ui(p->uniform("footprintSample"), uint32_t(stats.emitterSampleCount));
+            }
+            addVisibleLight(*this, emitterProgram, emitterCurvedProgram, cube);
             ++stats.emitterSampleCount;
         }
         glUseProgram(emitterFoldProgram.id());
@@ -288,15 +303,17 @@ void Baker::Impl::bakePunctualLights() {
 
         const glm::vec3 intensity = light.intensity / radianceUnit;
         const float cosOuter = std::cos(light.outerConeAngle), cosInner = std::cos(light.innerConeAngle);
-        glUseProgram(punctualProgram.id());
-        glUniform3fv(punctualProgram.uniform("lightPosition"), 1, &position.x);
-        glUniform3fv(punctualProgram.uniform("lightIntensity"), 1, &intensity.x);
-        glUniform1f(punctualProgram.uniform("lightRange"), light.range);
-        glUniform1i(punctualProgram.uniform("lightIsSpot"), light.type == PunctualLight::Type::Spot);
-        glUniform3fv(punctualProgram.uniform("spotDirection"), 1, &light.direction.x);
-        glUniform1f(punctualProgram.uniform("spotCosOuter"), cosOuter);
-        glUniform1f(punctualProgram.uniform("spotScale"), 1.0f / std::max(0.001f, cosInner - cosOuter));
-        addVisibleLight(*this, punctualProgram, cube);
+        for (const gl::Program* p : {&punctualProgram, &punctualCurvedProgram}) {
+            glUseProgram(p->id());
+            glUniform3fv(p->uniform("lightPosition"), 1, &position.x);
+            glUniform3fv(p->uniform("lightIntensity"), 1, &intensity.x);
+            glUniform1f(p->uniform("lightRange"), light.range);
+            glUniform1i(p->uniform("lightIsSpot"), light.type == PunctualLight::Type::Spot);
+            glUniform3fv(p->uniform("spotDirection"), 1, &light.direction.x);
+            glUniform1f(p->uniform("spotCosOuter"), cosOuter);
+            glUniform1f(p->uniform("spotScale"), 1.0f / std::max(0.001f, cosInner - cosOuter));
+        }
+        addVisibleLight(*this, punctualProgram, punctualCurvedProgram, cube);
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }

@@ -17,17 +17,14 @@
 // at each sample's own x, leaned toward the points with the largest r, those
 // that see the light most obliquely, and read the ceiling texels along a
 // panel light's outline 50-80 % dark (the shared Cornell box).
+// CURVED_FOOTPRINT (define): curved texels (lib/curved_footprint.glsl), one
+// point each (lightmap/curved.vert), their points on the triangles that hold them.
 #include "shared/bundle_layout.h"
 #include "shared/mesh_layout.h"
 #include "lib/rounding.glsl"
 #include "lib/texel_footprint.glsl"
 #include "lib/polygon_irradiance.glsl"
 #include "lib/cube_visibility.glsl"
-
-in vec3 vPosition;
-in vec3 vNormal;
-in vec3 vBary;
-flat in uint vFlags;
 
 layout(binding = BINDING_EMITTER_SUMS, rgba32f) uniform coherent image2DArray sums;  // (sum F, sum w V, sum w, -)
 uniform vec3 emitterA, emitterB, emitterC;  // world vertices
@@ -38,6 +35,7 @@ uniform int page;
 uniform uint footprintSample;              // this emitter sample's index over all emitters
 layout(binding = BINDING_FOOTPRINT_CELLS) uniform usampler2DArray footprintCells;
 const uint NEAR_FIELD_POINTS = 16u;  // F's points a sample within a texel of the emitter's plane
+#include "direct/footprint_point.glsl"
 
 // F from point p with normal n. Behind a single-sided emitter nothing
 // arrives, and a point in its plane (the emitter's own texels, a coplanar
@@ -50,16 +48,10 @@ float formFactorAt(vec3 p, vec3 n) {
 }
 
 void main() {
-    vec3 positionDx = dFdx(vPosition), positionDy = dFdy(vPosition);
-    vec3 normalDx = dFdx(vNormal), normalDy = dFdy(vNormal);
-    vec3 baryDx = dFdx(vBary), baryDy = dFdy(vBary);
-    if (gl_HelperInvocation) return;
-    ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), page);
-    uvec2 cells = texelFetch(footprintCells, texel, 0).rg;
-    vec2 jitter = footprintOffset(vBary, baryDx, baryDy, vFlags, cells, footprintSample);
-    vec3 n = normalize(vNormal + normalDx * jitter.x + normalDy * jitter.y);
-    vec3 x = vPosition + positionDx * jitter.x + positionDy * jitter.y;
-    float f = formFactorAt(x, n);
+    TexelFootprint texel;
+    if (!texelFootprint(texel)) return;
+    FootprintPoint x = footprintPoint(texel, footprintSample);
+    float f = formFactorAt(x.position, x.normal);
     // F's mean over the footprint. Within a texel of the emitter's plane F
     // steps from 0 to 1 across the footprint along the emitter's outline (the
     // shared Cornell box's ceiling, 0.9 mm over its light, 20 mm texels), and
@@ -69,24 +61,23 @@ void main() {
     // NEAR_FIELD_POINTS points): within 0.1 % there, 1.2 % on texels a
     // thirtieth over the outline.
     float fMean = f;
-    float texelSize = max(length(positionDx), length(positionDy));
-    if (abs(dot(emitterNormal, vPosition - emitterA)) < texelSize) {
+    if (abs(dot(emitterNormal, texel.centre - emitterA)) < texel.size) {
         fMean = 0.0;
         for (uint k = 0u; k < NEAR_FIELD_POINTS; ++k) {
-            vec2 o = footprintOffset(vBary, baryDx, baryDy, vFlags, cells, footprintSample * NEAR_FIELD_POINTS + k);
-            fMean += formFactorAt(vPosition + positionDx * o.x + positionDy * o.y,
-                                  normalize(vNormal + normalDx * o.x + normalDy * o.y));
+            FootprintPoint p = footprintPoint(texel, footprintSample * NEAR_FIELD_POINTS + k);
+            fMean += formFactorAt(p.position, p.normal);
         }
         fMean /= float(NEAR_FIELD_POINTS);
     }
     // the sample's weight and visibility; below x's horizon it counts in F's mean only
-    vec3 toX = x - samplePoint;
+    vec3 toX = x.position - samplePoint;
     float r2 = dot(toX, toX);
-    float cosX = -dot(n, toX), cosE = abs(dot(emitterNormal, toX));
+    float cosX = -dot(x.normal, toX), cosE = abs(dot(emitterNormal, toX));
     float w = 0.0, seen = 0.0;
     if (f > 0.0 && cosX > 0.0) {
         w = cosX * cosE / (r2 * r2);
-        seen = occludedFromLight(x, cross(positionDx, positionDy), samplePoint) ? 0.0 : 1.0;
+        seen = occludedFromLight(x.position, x.plane, samplePoint) ? 0.0 : 1.0;
     }
-    if (fMean > 0.0 || w > 0.0) imageStore(sums, texel, imageLoad(sums, texel) + vec4(fMean, w * seen, w, 0.0));
+    if (fMean > 0.0 || w > 0.0)
+        imageStore(sums, texel.texel, imageLoad(sums, texel.texel) + vec4(fMean, w * seen, w, 0.0));
 }

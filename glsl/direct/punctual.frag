@@ -3,26 +3,39 @@
 // E / pi, E = intensity x cos / d^2 x range window x cone falloff
 // (lib/punctual_light.glsl), times the visibility read from the light's
 // distance cube map, as the emitter samples are (direct/emitter.frag). Adds
-// to the direct light's float sums (lib/direct_scratch.glsl).
+// to the direct light's float sums (lib/direct_scratch.glsl). A flat texel
+// takes it at its centre; a curved one (CURVED_FOOTPRINT), whose surface
+// turns within it, as the mean over CURVED_POINTS points of its footprint.
 #include "shared/bundle_layout.h"
+#include "shared/mesh_layout.h"
+#include "lib/rounding.glsl"
+#include "lib/texel_footprint.glsl"
 #include "lib/punctual_light.glsl"
 #include "lib/cube_visibility.glsl"
-
-in vec3 vPosition;
-in vec3 vNormal;
-
 #include "lib/direct_scratch.glsl"
 uniform int page;
+layout(binding = BINDING_FOOTPRINT_CELLS) uniform usampler2DArray footprintCells;
+#include "direct/footprint_point.glsl"
 
 const float PI = 3.14159265358979;
+const uint CURVED_POINTS = 256u;
+
+// E / pi at x, 0 where it is shadowed
+vec3 lightAt(FootprintPoint x) {
+    vec3 e = punctualIrradiance(x.position, x.normal);
+    if (e == vec3(0.0)) return e;  // below the horizon, outside the cone or the range
+    return occludedFromLight(x.position, x.plane, lightPosition) ? vec3(0.0) : e / PI;
+}
 
 void main() {
-    vec3 facet = cross(dFdx(vPosition), dFdy(vPosition));
-    if (gl_HelperInvocation) return;
-    vec3 n = normalize(vNormal);
-    vec3 x = vPosition;
-    vec3 e = punctualIrradiance(x, n);
-    if (e == vec3(0.0)) return;  // below the horizon, outside the cone or the range
-    if (occludedFromLight(x, facet, lightPosition)) return;
-    addDirect(ivec3(ivec2(gl_FragCoord.xy), page), e / PI);
+    TexelFootprint texel;
+    if (!texelFootprint(texel)) return;
+#ifdef CURVED_FOOTPRINT
+    vec3 sum = vec3(0.0);
+    for (uint k = 0u; k < CURVED_POINTS; ++k) sum += lightAt(footprintPoint(texel, k));
+    vec3 light = sum / float(CURVED_POINTS);
+#else
+    vec3 light = lightAt(FootprintPoint(vPosition, normalize(vNormal), cross(texel.positionDx, texel.positionDy)));
+#endif
+    if (light != vec3(0.0)) addDirect(texel.texel, light);
 }

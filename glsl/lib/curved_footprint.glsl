@@ -5,8 +5,9 @@
 // leaves the surface, and every sample read the light of one facet's
 // orientation (the piping's texels 15 against the reference's 120). Such
 // texels (engine/layout/bake_mesh.h curvedTexels) are drawn as points, one per
-// texel, and each sample finds its footprint point on the triangle that holds
-// it: its position, shading normal and plane are that triangle's.
+// texel (lightmap/curved.vert), by the update, sun, emitter and point light
+// passes, and each sample finds its footprint point on the triangle that
+// holds it: its position, shading normal and plane are that triangle's.
 //
 // Needs shared/bundle_layout.h, lib/rounding.glsl and lib/texel_footprint.glsl.
 

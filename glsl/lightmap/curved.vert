@@ -1,7 +1,8 @@
 #version 430
-// Update and sun passes on curved texels (lib/curved_footprint.glsl): one
-// point a texel, at its centre on its page, drawn in runs of the tile's
-// clusters (engine/bake/curved_footprints.h).
+// Curved texels (lib/curved_footprint.glsl): one point a texel, at its
+// centre on its page; the update and sun passes draw them in runs of the
+// tile's clusters (engine/bake/curved_footprints.h), the direct light passes
+// all at once.
 #include "shared/bundle_layout.h"
 #include "shared/mesh_layout.h"
 #include "lib/rounding.glsl"

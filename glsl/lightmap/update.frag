@@ -425,7 +425,19 @@ void main() {
             self = ownCrossing(own, neighbour, offset - vec2(step) * pixelSize);
             if (self != NO_CROSSING) pixel = neighbour;
         }
+#if defined(CURVED_FOOTPRINT) && defined(SUN_PASS)
+        // A curved texel's sun sample counts whatever its light: skipped, the
+        // facets the sun grazes (those between a tube's lit and dark halves)
+        // went missing from the mean, and a tube read 5 % bright. It reads
+        // along its own pixel's ray from its own depth instead (geometry finer
+        // than a pixel, or a grazing facet: a small cosine either way). The
+        // update pass's samples weigh by their cosine, and are skipped: a
+        // ray beside the point from its own depth starts inside a convex
+        // surface and sees its back (a sphere in the furnace 1.3 % dark).
+        if (self == NO_CROSSING) self = b.z;
+#else
         if (self == NO_CROSSING) return;
+#endif
     }
     float start = self + (ahead ? depthBias : -depthBias);
 
