@@ -90,6 +90,36 @@ Expected<LightmapPages> bakeTube(Scene scene, BakeOptions options, BakeStats* st
     return bakeGpu(scene, *layout, options, nullptr, stats);
 }
 
+// The mean of light(point, unit normal) over texel x's part of the tube (a
+// whole turn over its x range: u over [2, 30) texels is x over [-2, 2]).
+template <class F>
+double turnMean(int x, F&& light) {
+    const double dx = 2.0 * kHalfLength / 28.0, x0 = -kHalfLength + (x - 2) * dx;
+    const int nx = 8, nt = 360;
+    double sum = 0.0;
+    for (int i = 0; i < nx; ++i)
+        for (int k = 0; k < nt; ++k) {
+            const double a = 2.0 * PI * (k + 0.5) / nt;
+            const glm::dvec3 n(0.0, std::cos(a), std::sin(a));
+            sum += light(glm::dvec3(x0 + dx * (i + 0.5) / nx, 0.0, 0.0) + double(kRadius) * n, n);
+        }
+    return sum / (double(nx) * nt);
+}
+
+// Every texel of the row (red) against its turnMean of `light`, within
+// `tolerance` (relative); prints the worst.
+template <class F>
+void expectRowMeans(const LightmapPages& maps, const char* what, double tolerance, F&& light) {
+    double worst = 0.0;
+    for (int x = 4; x < 28; ++x) {
+        const double expected = turnMean(x, light);
+        const double value = maps.pages[0].pixels[size_t(kRow) * kRes + size_t(x)].r;
+        worst = std::max(worst, std::fabs(value / expected - 1.0));
+        EXPECT_NEAR(value, expected, tolerance * expected) << what << ", texel " << x;
+    }
+    std::printf("[curved] tube under %s: worst texel %.2f %% off its mean over the turn\n", what, 100 * worst);
+}
+
 // The sun pass: 256 points of each texel's footprint (sunJitter 16), the same
 // R2 points in every texel, so the row shares one quadrature error (+0.07 %
 // for max(0, cos) over the turn). Measured: every texel within 0.06 % (-0.05 %
@@ -138,27 +168,11 @@ TEST(CurvedFootprintBake, TubeUnderAPointLightReadsItsTurnsMean) {
     BakeStats stats;
     auto maps = bakeTube(scene, options, &stats);
     ASSERT_TRUE(maps) << maps.error();
-    double worst = 0.0;
-    for (int x = 4; x < 28; ++x) {
-        // the texel's x range along the tube (u over [2, 30) texels is x over [-2, 2])
-        const double x0 = -kHalfLength + (x - 2) * (2.0 * kHalfLength / 28.0), dx = 2.0 * kHalfLength / 28.0;
-        double expected = 0.0;
-        const int nx = 16, nt = 720;
-        for (int i = 0; i < nx; ++i)
-            for (int k = 0; k < nt; ++k) {
-                const double a = 2.0 * PI * (k + 0.5) / nt;
-                const glm::dvec3 n(0.0, std::cos(a), std::sin(a));
-                const glm::dvec3 p = glm::dvec3(x0 + dx * (i + 0.5) / nx, 0.0, 0.0) + double(kRadius) * n;
-                const glm::dvec3 toLight = light.position - p;
-                const double d2 = glm::dot(toLight, toLight);
-                expected += 2500.0 * std::max(0.0, glm::dot(n, toLight) / std::sqrt(d2)) / (d2 * PI);
-            }
-        expected /= double(nx) * nt;
-        const double value = maps->pages[0].pixels[size_t(kRow) * kRes + size_t(x)].r;
-        worst = std::max(worst, std::fabs(value / expected - 1.0));
-        EXPECT_NEAR(value, expected, 0.015 * expected) << "texel " << x;
-    }
-    std::printf("[curved] tube under a point light: worst texel %.2f %% off its mean over the turn\n", 100 * worst);
+    expectRowMeans(*maps, "a point light", 0.015, [&](const glm::dvec3& p, const glm::dvec3& n) {
+        const glm::dvec3 toLight = light.position - p;
+        const double d2 = glm::dot(toLight, toLight);
+        return 2500.0 * std::max(0.0, glm::dot(n, toLight) / std::sqrt(d2)) / (d2 * PI);
+    });
 }
 
 // Form factor from x (unit normal n) to the convex polygon `poly`, clipped
@@ -195,23 +209,8 @@ TEST(CurvedFootprintBake, TubeUnderAQuadLightReadsItsTurnsMean) {
     BakeStats stats;
     auto maps = bakeTube(scene, options, &stats);
     ASSERT_TRUE(maps) << maps.error();
-    double worst = 0.0;
-    for (int x = 4; x < 28; ++x) {
-        const double x0 = -kHalfLength + (x - 2) * (2.0 * kHalfLength / 28.0), dx = 2.0 * kHalfLength / 28.0;
-        double expected = 0.0;
-        const int nx = 4, nt = 360;
-        for (int i = 0; i < nx; ++i)
-            for (int k = 0; k < nt; ++k) {
-                const double a = 2.0 * PI * (k + 0.5) / nt;
-                const glm::dvec3 n(0.0, std::cos(a), std::sin(a));
-                expected += clippedFormFactor(glm::dvec3(x0 + dx * (i + 0.5) / nx, 0.0, 0.0) + double(kRadius) * n, n, quad);
-            }
-        expected /= double(nx) * nt;
-        const double value = maps->pages[0].pixels[size_t(kRow) * kRes + size_t(x)].r;
-        worst = std::max(worst, std::fabs(value / expected - 1.0));
-        EXPECT_NEAR(value, expected, 0.015 * expected) << "texel " << x;
-    }
-    std::printf("[curved] tube under a quad light: worst texel %.2f %% off its mean over the turn\n", 100 * worst);
+    expectRowMeans(*maps, "a quad light", 0.015,
+                   [&](const glm::dvec3& p, const glm::dvec3& n) { return clippedFormFactor(p, n, quad); });
 }
 
 // The update pass: 1024 directions, one footprint point each (the same point

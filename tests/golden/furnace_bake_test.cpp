@@ -28,6 +28,7 @@
 #include <cstdio>
 
 #include "support/bake_helper.h"
+#include "support/hand_scenes.h"
 
 namespace bb::test {
 namespace {
@@ -172,6 +173,34 @@ void runScaledFurnace(float le) {
 
 TEST(FurnaceBake, BeyondTheFp16RangeReadsTheAnalyticValue) { runScaledFurnace(1e5f); }
 TEST(FurnaceBake, FarBelowOneReadsTheAnalyticValue) { runScaledFurnace(1e-5f); }
+
+// The history ramp's power and the refresh schedule follow the scene's
+// largest albedo (defaultHistoryPower), a textured material's being its
+// factor times its texture's mean: a factor of 1 on a texture of mean 0.5
+// (texels 0.3 and 0.7) is rho 0.5 (power 3), not 1 (the cap, 1024: only the
+// last half of the directions would count). Exact.
+TEST(HistoryRamp, TexturedAlbedoCountsAtItsTexturesMean) {
+    BB_REQUIRE_GL();
+    Scene scene;
+    Texture grey;
+    grey.name = "grey";
+    grey.width = 2;
+    grey.height = 1;
+    grey.texels = {glm::vec4(0.3f, 0.3f, 0.3f, 1.0f), glm::vec4(0.7f, 0.7f, 0.7f, 1.0f)};
+    scene.textures.push_back(grey);
+    const int textured = addMaterial(scene, glm::vec3(1.0f));
+    scene.materials[size_t(textured)].albedoTexture = 0;
+    addQuad(scene, glm::vec3(0.0f), glm::vec3(1.0f, 0.0f, 0.0f), glm::vec3(0.0f, 0.0f, -1.0f), textured, "floor");
+    auto layout = packLayout(scene, 32, 10.0f);
+    ASSERT_TRUE(layout) << layout.error();
+    BakeOptions options;
+    options.directions = 4;
+    BakeStats stats;
+    auto maps = bakeGpu(scene, *layout, options, nullptr, &stats);
+    ASSERT_TRUE(maps) << maps.error();
+    EXPECT_EQ(stats.historyPower, defaultHistoryPower(0.5));
+    EXPECT_EQ(defaultHistoryPower(0.5), 3.0);
+}
 
 }  // namespace
 }  // namespace bb::test
