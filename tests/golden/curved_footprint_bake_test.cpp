@@ -59,16 +59,7 @@ Scene tubeScene() {
         p.indices.insert(p.indices.end(), {a, d, c, a, c, b});
     }
     p.material = black;
-    Mesh mesh;
-    mesh.name = "tube";
-    mesh.primitives.push_back(std::move(p));
-    scene.meshes.push_back(std::move(mesh));
-    Instance inst;
-    inst.name = "tube";
-    inst.mesh = 0;
-    inst.node = 0;
-    scene.instances.push_back(inst);
-    for (const glm::vec3& x : scene.meshes[0].primitives[0].positions) scene.bounds.extend(x);
+    addPrimitive(scene, std::move(p), "tube");
     return scene;
 }
 

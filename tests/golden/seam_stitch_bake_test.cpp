@@ -57,16 +57,7 @@ void addSphere(Scene& scene, glm::vec3 centre, float radius, int segments, int r
             if (r != rings - 1) p.indices.insert(p.indices.end(), {a, d, c});
         }
     p.material = material;
-    Mesh m;
-    m.name = "sphere";
-    m.primitives.push_back(std::move(p));
-    scene.meshes.push_back(std::move(m));
-    Instance inst;
-    inst.name = "sphere";
-    inst.mesh = int(scene.meshes.size()) - 1;
-    inst.node = int(scene.instances.size());
-    scene.instances.push_back(inst);
-    for (const glm::vec3& x : scene.meshes.back().primitives[0].positions) scene.bounds.extend(x);
+    addPrimitive(scene, std::move(p), "sphere");
 }
 
 // Texel-to-texel noise of the charts' interiors (see the file comment).

@@ -34,6 +34,21 @@ inline int addMaterial(Scene& scene, glm::vec3 albedo, glm::vec3 emission = glm:
     return int(scene.materials.size()) - 1;
 }
 
+// `p` as its own mesh and instance `name` (identity transform); returns the instance index.
+inline int addPrimitive(Scene& scene, Primitive p, const std::string& name) {
+    for (const glm::vec3& x : p.positions) scene.bounds.extend(x);
+    Mesh m;
+    m.name = name;
+    m.primitives.push_back(std::move(p));
+    scene.meshes.push_back(std::move(m));
+    Instance inst;
+    inst.name = name;
+    inst.mesh = int(scene.meshes.size()) - 1;
+    inst.node = int(scene.instances.size());
+    scene.instances.push_back(inst);
+    return int(scene.instances.size()) - 1;
+}
+
 // A single-sided parallelogram centre +- e1 +- e2 facing normalize(e1 x e2),
 // as its own mesh and instance; TEXCOORD_1 (0,0) at centre - e1 - e2, u along
 // e1, v along e2. Returns the instance index.
@@ -47,17 +62,7 @@ inline int addQuad(Scene& scene, const glm::vec3& centre, const glm::vec3& e1, c
     p.uv0 = p.uv1;
     p.indices = {0, 1, 2, 0, 2, 3};  // counter-clockwise seen from n
     p.material = material;
-    Mesh m;
-    m.name = name;
-    m.primitives.push_back(std::move(p));
-    scene.meshes.push_back(std::move(m));
-    Instance inst;
-    inst.name = name;
-    inst.mesh = int(scene.meshes.size()) - 1;
-    inst.node = int(scene.instances.size());
-    scene.instances.push_back(inst);
-    for (const glm::vec3& x : scene.meshes.back().primitives[0].positions) scene.bounds.extend(x);
-    return int(scene.instances.size()) - 1;
+    return addPrimitive(scene, std::move(p), name);
 }
 
 // The six faces of a box (centre, half extents along the columns of `axes`, a
