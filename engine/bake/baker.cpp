@@ -301,14 +301,23 @@ void Baker::Impl::coveragePass() {
     std::vector<uint8_t> codes(size_t(res) * res), neighbours(codes.size());
     std::vector<uint16_t> ownerCharts(codes.size());
     std::vector<std::vector<CurvedTexel>> curved(size_t(layout.pageCount));
-    std::vector<std::vector<int32_t>> pageOwners(size_t(layout.pageCount));
+    // the curved texels' records are SSBOs: their triangles' (144 B each, at most one a reference) within one binding
+    GLint64 maxSsbo = 0;
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxSsbo);
+    int64_t curvedRefs = 0, flatInstead = 0;
     for (int p = 0; p < layout.pageCount; ++p) {
         gl::readTexture(dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, codes.data());
         stats.coveredTexels += std::count(codes.begin(), codes.end(), uint8_t(DILATION_SELF));
-        const std::vector<int32_t>& owners = pageOwners[size_t(p)] = texelOwners(mesh, p, res);
+        const std::vector<int32_t> owners = texelOwners(mesh, p, res);
         chartNeighbourBits(codes, owners, charts, res, neighbours);
         curved[size_t(p)] = curvedTexels(mesh, p, res, owners, charts);
-        std::erase_if(curved[size_t(p)], [&](const CurvedTexel& c) { return codes[c.texel] != DILATION_SELF; });
+        std::erase_if(curved[size_t(p)], [&](const CurvedTexel& c) {
+            if (codes[c.texel] != DILATION_SELF) return true;
+            curvedRefs += int64_t(c.triangles.size());
+            if (curvedRefs * int64_t(sizeof(CurvedTriangle)) <= maxSsbo) return false;
+            ++flatInstead;  // past the binding's size: the flat texels' footprint along the owner's plane
+            return true;
+        });
         for (size_t i = 0; i < owners.size(); ++i)
             ownerCharts[i] = uint16_t(owners[i] < 0 ? TEXEL_CHART_MASK : charts[size_t(owners[i])] & TEXEL_CHART_MASK);
         for (const CurvedTexel& c : curved[size_t(p)]) ownerCharts[c.texel] |= TEXEL_CURVED;
@@ -321,7 +330,11 @@ void Baker::Impl::coveragePass() {
         dilationCodes(codes, res, radius);
         gl::writeTexture(dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, codes.data());
     }
-    uploadCurvedTexels(curved, pageOwners);
+    uploadCurvedTexels(curved);
+    if (flatInstead > 0)
+        logWarning(std::to_string(flatInstead) + " texels whose charts curve within them are baked as flat ones: the "
+                   "curved texels' records would pass GL_MAX_SHADER_STORAGE_BLOCK_SIZE (" + std::to_string(maxSsbo) +
+                   " bytes); lower --resolution or --texel-density");
     stats.lightmapTexels = int64_t(res) * res * layout.pageCount;
     if (stats.sharedTexels * 100 > stats.coveredTexels)  // over 1 %: worth the user's look
         logWarning(std::to_string(stats.sharedTexels) + " of " + std::to_string(stats.coveredTexels) +
@@ -330,10 +343,9 @@ void Baker::Impl::coveragePass() {
                    "or space the charts further apart");
 }
 
-void Baker::Impl::uploadCurvedTexels(const std::vector<std::vector<CurvedTexel>>& pages,
-                                     const std::vector<std::vector<int32_t>>& owners) {
+void Baker::Impl::uploadCurvedTexels(const std::vector<std::vector<CurvedTexel>>& pages) {
     MemoryCategory category("light maps");
-    CurvedFootprints curved = buildCurvedFootprints(mesh, clusters, layout.resolution, pages, owners);
+    CurvedFootprints curved = buildCurvedFootprints(mesh, clusters, layout.resolution, pages);
     stats.curvedTexels = int64_t(curved.count());
     if (curved.count() == 0) return;
     curvedTexelBuffer = gl::Buffer::create("curved texels", int64_t(curved.texels.size() * sizeof(glm::uvec4)),

@@ -128,8 +128,7 @@ struct Baker::Impl {
     // page and material, setting `page` and, if asked, the material's uniforms and textures.
     void drawSurface(GLuint program, bool materialUniforms);
     void coveragePass();
-    void uploadCurvedTexels(const std::vector<std::vector<CurvedTexel>>& pages,
-                            const std::vector<std::vector<int32_t>>& owners);
+    void uploadCurvedTexels(const std::vector<std::vector<CurvedTexel>>& pages);
     void bakeSun();
     void foldDirect(bool perSample);
     bool useExplicitEmitters() const;

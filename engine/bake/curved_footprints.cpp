@@ -49,9 +49,7 @@ CurvedTriangle curvedTriangle(const BakeMesh& mesh, uint32_t t, int res) {
 }  // namespace
 
 CurvedFootprints buildCurvedFootprints(const BakeMesh& mesh, const std::vector<Cluster>& clusters, int res,
-                                       const std::vector<std::vector<CurvedTexel>>& pages,
-                                       const std::vector<std::vector<int32_t>>& owners) {
-    CHECK_EQ(pages.size(), owners.size());
+                                       const std::vector<std::vector<CurvedTexel>>& pages) {
     // each texel's cluster: its owner's (clusters are runs of mesh order)
     std::vector<uint32_t> clusterStarts(clusters.size());
     for (size_t c = 0; c < clusters.size(); ++c) clusterStarts[c] = clusters[c].first;
@@ -63,7 +61,7 @@ CurvedFootprints buildCurvedFootprints(const BakeMesh& mesh, const std::vector<C
     std::vector<Entry> entries;
     for (size_t p = 0; p < pages.size(); ++p)
         for (const CurvedTexel& texel : pages[p]) {
-            const uint32_t owner = uint32_t(owners[p][texel.texel]);
+            const uint32_t owner = texel.triangles.front();
             const auto it = std::upper_bound(clusterStarts.begin(), clusterStarts.end(), owner);
             CHECK(it != clusterStarts.begin());
             entries.push_back({uint32_t(it - clusterStarts.begin() - 1), uint32_t(p), &texel});

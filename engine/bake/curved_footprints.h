@@ -39,11 +39,9 @@ struct CurvedFootprints {
     }
 };
 
-// pages[p]: page p's curvedTexels (res x res pages); `owners[p]` its texel
-// owners. Texels go with their owner triangle's cluster (the tile that draws
-// it draws them). Deterministic.
+// pages[p]: page p's curvedTexels (res x res pages). Texels go with their
+// owner triangle's cluster (the tile that draws it draws them). Deterministic.
 CurvedFootprints buildCurvedFootprints(const BakeMesh& mesh, const std::vector<Cluster>& clusters, int res,
-                                       const std::vector<std::vector<CurvedTexel>>& pages,
-                                       const std::vector<std::vector<int32_t>>& owners);
+                                       const std::vector<std::vector<CurvedTexel>>& pages);
 
 }  // namespace bb
