@@ -93,16 +93,9 @@ void BundleTracer::drawCurvedTexels(GLuint program, const std::vector<uint32_t>&
     if (curvedClusterFirst_.empty()) return;
     drawFirst_.clear();
     drawCount_.clear();
-    for (uint32_t c : ids) {
-        const int32_t first = int32_t(curvedClusterFirst_[c]), count = int32_t(curvedClusterFirst_[c + 1]) - first;
-        if (count == 0) continue;
-        if (!drawFirst_.empty() && drawFirst_.back() + drawCount_.back() == first)
-            drawCount_.back() += count;
-        else {
-            drawFirst_.push_back(first);
-            drawCount_.push_back(count);
-        }
-    }
+    for (uint32_t c : ids)
+        appendDrawRange(drawFirst_, drawCount_, int32_t(curvedClusterFirst_[c]),
+                        int32_t(curvedClusterFirst_[c + 1] - curvedClusterFirst_[c]));
     if (drawFirst_.empty()) return;
     bindCurvedTexels_(program);
     glMultiDrawArrays(GL_POINTS, drawFirst_.data(), drawCount_.data(), GLsizei(drawFirst_.size()));

@@ -15,11 +15,6 @@ float bitsAsFloat(uint32_t bits) {
     std::memcpy(&f, &bits, 4);
     return f;
 }
-uint32_t floatBits(float f) {
-    uint32_t bits;
-    std::memcpy(&bits, &f, 4);
-    return bits;
-}
 
 CurvedTriangle curvedTriangle(const BakeMesh& mesh, uint32_t t, int res) {
     TexelAffine position, normal;
@@ -81,12 +76,7 @@ CurvedFootprints buildCurvedFootprints(const BakeMesh& mesh, const std::vector<C
             if (added) out.triangles.push_back(curvedTriangle(mesh, t, res));
             out.refs.push_back(it->second);
         }
-        // the owner's point at the centre (the leaf that takes the texel's samples)
-        TexelAffine owner;
-        CHECK(texelAffine(mesh, texel.triangles.front(), res, false, owner));
-        const glm::vec3 centre(owner.at(glm::dvec2(x + 0.5, y + 0.5)));
         out.texels.push_back(glm::uvec4(x | (y << 16), e.page, firstRef, uint32_t(texel.triangles.size())));
-        out.texels.push_back(glm::uvec4(floatBits(centre.x), floatBits(centre.y), floatBits(centre.z), 0u));
     }
     for (size_t c = 0; c < clusters.size(); ++c) out.clusterFirst[c + 1] += out.clusterFirst[c];
     return out;

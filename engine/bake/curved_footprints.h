@@ -29,11 +29,11 @@ struct CurvedTriangle {
 static_assert(sizeof(CurvedTriangle) == 144);
 
 struct CurvedFootprints {
-    std::vector<glm::uvec4> texels;          // two per curved texel (lib/curved_footprint.glsl), in cluster order
+    std::vector<glm::uvec4> texels;          // one per curved texel (lib/curved_footprint.glsl), in cluster order
     std::vector<uint32_t> refs;              // per texel its triangles, owner first
     std::vector<CurvedTriangle> triangles;   // each once
     std::vector<uint32_t> clusterFirst;      // per cluster, its first curved texel (its owner's); then the count
-    size_t count() const { return texels.size() / 2; }
+    size_t count() const { return texels.size(); }
     int64_t bytes() const {
         return int64_t(texels.size() * sizeof(glm::uvec4) + refs.size() * 4 + triangles.size() * sizeof(CurvedTriangle));
     }

@@ -237,47 +237,50 @@ bool texelAffine(const BakeMesh& mesh, uint32_t t, int res, bool normals, TexelA
 
 std::vector<CurvedTexel> curvedTexels(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,
                                       const std::vector<uint32_t>& chart, double departure) {
-    // (texel, triangle) for every triangle of a covered texel's chart overlapping its square with area
-    std::vector<std::pair<uint32_t, uint32_t>> overlaps;
+    // every triangle of a covered texel's chart overlapping its square with
+    // area, and how far it leaves the owner's plane there (at the corners of
+    // its piece of the square), in the owner's texel sizes
+    struct Overlap {
+        uint32_t texel, triangle;
+        double departure;
+    };
+    std::vector<Overlap> overlaps;
     for (uint32_t t = mesh.pageFirstTriangle[size_t(page)]; t < mesh.pageFirstTriangle[size_t(page) + 1]; ++t) {
         glm::dvec2 q[3];
         const double absArea = pageCorners(mesh, t, res, q);
-        if (absArea == 0.0 || !std::isfinite(absArea)) continue;
+        TexelAffine surface;
+        if (absArea == 0.0 || !std::isfinite(absArea) || !texelAffine(mesh, t, res, false, surface)) continue;
         const TexelRange r = texelsUnder(q, res);
         for (int y = r.y0; y <= r.y1; ++y)
             for (int x = r.x0; x <= r.x1; ++x) {
                 const size_t i = size_t(y) * res + x;
                 if (owner[i] < 0 || chart[size_t(owner[i])] != chart[t]) continue;
-                const glm::dvec2 o(x, y);
-                const glm::dvec2 local[3] = {q[0] - o, q[1] - o, q[2] - o};
-                if (polygonArea(clipSquare(local)) > 0.0) overlaps.push_back({uint32_t(i), t});
+                const glm::dvec2 corner(x, y);
+                const glm::dvec2 local[3] = {q[0] - corner, q[1] - corner, q[2] - corner};
+                const std::vector<glm::dvec2> piece = clipSquare(local);
+                if (!(polygonArea(piece) > 0.0)) continue;
+                TexelAffine own;
+                double worst = 0.0;
+                if (uint32_t(owner[i]) != t && texelAffine(mesh, uint32_t(owner[i]), res, false, own)) {
+                    for (const glm::dvec2& p : piece)
+                        worst = std::max(worst, glm::length(surface.at(corner + p) - own.at(corner + p)));
+                    worst /= std::max(glm::length(own.dx), glm::length(own.dy));
+                }
+                overlaps.push_back({uint32_t(i), t, worst});
             }
     }
-    std::sort(overlaps.begin(), overlaps.end());
+    std::sort(overlaps.begin(), overlaps.end(),
+              [](const Overlap& a, const Overlap& b) { return std::tie(a.texel, a.triangle) < std::tie(b.texel, b.triangle); });
     std::vector<CurvedTexel> curved;
     for (size_t begin = 0, end; begin < overlaps.size(); begin = end) {
-        const uint32_t i = overlaps[begin].first;
-        for (end = begin; end < overlaps.size() && overlaps[end].first == i;) ++end;
-        const uint32_t o = uint32_t(owner[i]);
-        TexelAffine own;
-        if (end - begin < 2 || !texelAffine(mesh, o, res, false, own)) continue;
-        const double texelSize = std::max(glm::length(own.dx), glm::length(own.dy));
-        const glm::dvec2 corner(double(i % uint32_t(res)), double(i / uint32_t(res)));
+        const uint32_t i = overlaps[begin].texel, o = uint32_t(owner[i]);
         double worst = 0.0;
-        for (size_t k = begin; k < end && worst <= departure * texelSize; ++k) {
-            const uint32_t t = overlaps[k].second;
-            TexelAffine surface;
-            glm::dvec2 q[3];
-            pageCorners(mesh, t, res, q);
-            if (t == o || !texelAffine(mesh, t, res, false, surface)) continue;
-            const glm::dvec2 local[3] = {q[0] - corner, q[1] - corner, q[2] - corner};
-            for (const glm::dvec2& p : clipSquare(local))
-                worst = std::max(worst, glm::length(surface.at(corner + p) - own.at(corner + p)));
-        }
-        if (!(worst > departure * texelSize)) continue;
+        for (end = begin; end < overlaps.size() && overlaps[end].texel == i; ++end)
+            worst = std::max(worst, overlaps[end].departure);
+        if (!(worst > departure)) continue;
         CurvedTexel texel{i, {o}};
         for (size_t k = begin; k < end; ++k)
-            if (overlaps[k].second != o) texel.triangles.push_back(overlaps[k].second);
+            if (overlaps[k].triangle != o) texel.triangles.push_back(overlaps[k].triangle);
         curved.push_back(std::move(texel));
     }
     return curved;

@@ -322,13 +322,17 @@ void clusterRanges(const std::vector<Cluster>& clusters, const std::vector<uint3
     for (uint32_t i : tileClusters) {
         const Cluster& c = clusters[i];
         const uint32_t n = receiversOnly ? c.receivers : c.count;
-        if (n == 0) continue;
-        if (!firstVertex.empty() && uint32_t(firstVertex.back() + vertexCount.back()) == 3 * c.first)
-            vertexCount.back() += int32_t(3 * n);
-        else {
-            firstVertex.push_back(int32_t(3 * c.first));
-            vertexCount.push_back(int32_t(3 * n));
-        }
+        appendDrawRange(firstVertex, vertexCount, int32_t(3 * c.first), int32_t(3 * n));
+    }
+}
+
+void appendDrawRange(std::vector<int32_t>& first, std::vector<int32_t>& count, int32_t rangeFirst, int32_t rangeCount) {
+    if (rangeCount == 0) return;
+    if (!first.empty() && first.back() + count.back() == rangeFirst)
+        count.back() += rangeCount;
+    else {
+        first.push_back(rangeFirst);
+        count.push_back(rangeCount);
     }
 }
 

@@ -154,4 +154,8 @@ std::vector<TileWindow> splitWindow(const TileWindow& window);
 void clusterRanges(const std::vector<Cluster>& clusters, const std::vector<uint32_t>& tileClusters,
                    std::vector<int32_t>& firstVertex, std::vector<int32_t>& vertexCount, bool receiversOnly = false);
 
+// Appends the draw range [rangeFirst, rangeFirst + rangeCount) to (first,
+// count), merged into the last range where it follows it; empty ones are left out.
+void appendDrawRange(std::vector<int32_t>& first, std::vector<int32_t>& count, int32_t rangeFirst, int32_t rangeCount);
+
 }  // namespace bb

@@ -31,10 +31,10 @@ struct FootprintPoint {
 
 #ifdef CURVED_FOOTPRINT
 bool texelFootprint(out TexelFootprint t) {
-    uvec4 head = curvedTexels[2u * vCurved];
+    uvec4 head = curvedTexels[vCurved];
     t.texel = ivec3(ivec2(gl_FragCoord.xy), int(head.y));
     t.cells = texelFetch(footprintCells, t.texel, 0).rg;
-    t.centre = uintBitsToFloat(curvedTexels[2u * vCurved + 1u].xyz);
+    t.centre = curvedTexelCentre(vCurved);
     CurvedTriangle owner = curvedTriangles[curvedRefs[head.z]];
     t.size = max(length(owner.positionDx.xyz), length(owner.positionDy.xyz));
     return true;

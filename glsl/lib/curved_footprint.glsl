@@ -11,9 +11,7 @@
 //
 // Needs shared/bundle_layout.h, lib/rounding.glsl and lib/texel_footprint.glsl.
 
-// A curved texel: uvec4(x | y << 16, page, first ref, ref count), then
-// uvec4(floatBitsToUint(centre.xyz), 0): the owner triangle's point at the
-// texel's centre (which leaf takes the texel's sample).
+// A curved texel: uvec4(x | y << 16, page, first ref, ref count).
 layout(std430, binding = BINDING_CURVED_TEXELS) readonly buffer CurvedTexels { uvec4 curvedTexels[]; };
 // Per curved texel, its triangles (indices into curvedTriangles), owner first.
 layout(std430, binding = BINDING_CURVED_REFS) readonly buffer CurvedRefs { uint curvedRefs[]; };
@@ -42,12 +40,21 @@ bool curvedTriangleHolds(CurvedTriangle c, vec2 p) {
     return all(greaterThanEqual(w * sign(area), vec3(0.0)));
 }
 
+// Curved texel `index`'s centre on its owner triangle (the first of its
+// triangles, which holds the centre): where the leaf that takes its samples is.
+vec3 curvedTexelCentre(uint index) {
+    uvec4 head = curvedTexels[index];
+    CurvedTriangle owner = curvedTriangles[curvedRefs[head.z]];
+    vec2 q = vec2(head.x & 0xffffu, head.x >> 16u) + 0.5 - owner.corners01.xy;
+    return owner.position.xyz + owner.positionDx.xyz * q.x + owner.positionDy.xyz * q.y;
+}
+
 // Sample `sampleIndex`'s point of curved texel `index` (its square's part on
 // the chart, uniform: candidates as footprintOffset draws them, each kept if
 // one of the texel's triangles holds it): page point `point`, triangle `tri`.
 // After 8 candidates the centre, which the owner holds.
 void curvedFootprintPoint(uint index, uvec2 cells, uint sampleIndex, out vec2 point, out CurvedTriangle tri) {
-    uvec4 head = curvedTexels[2u * index];
+    uvec4 head = curvedTexels[index];
     vec2 centre = vec2(head.x & 0xffffu, head.x >> 16u) + 0.5;
     for (int attempt = 0; attempt < 8; ++attempt) {
         vec2 offset = footprintCandidate(sampleIndex, attempt);

@@ -271,11 +271,9 @@ struct TexelSample {
 // pixel-centre crossings of footprintPixel assume one plane over the square.
 // False: another leaf's.
 bool curvedSample(out TexelSample s) {
-    uvec4 head = curvedTexels[2u * vCurved];
-    s.texel = ivec3(ivec2(gl_FragCoord.xy), int(head.y));
+    s.texel = ivec3(ivec2(gl_FragCoord.xy), int(curvedTexels[vCurved].y));
     // the leaf of the texel's centre takes its sample, as on flat texels
-    vec3 centre = uintBitsToFloat(curvedTexels[2u * vCurved + 1u].xyz);
-    if (!leafOwns(rootFromBundle(bundleFromWorld(centre).xy))) return false;
+    if (!leafOwns(rootFromBundle(bundleFromWorld(curvedTexelCentre(vCurved)).xy))) return false;
     vec2 point;
     CurvedTriangle tri;
     curvedFootprintPoint(vCurved, texelFetch(footprintCells, s.texel, 0).rg, footprintSample, point, tri);
