@@ -322,9 +322,16 @@ void Baker::Impl::coveragePass() {
             ownerCharts[i] = uint16_t(owners[i] < 0 ? TEXEL_CHART_MASK : charts[size_t(owners[i])] & TEXEL_CHART_MASK);
         for (const CurvedTexel& c : curved[size_t(p)]) ownerCharts[c.texel] |= TEXEL_CURVED;
         gl::writeTexture(texelCharts.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_SHORT, 2, ownerCharts.data());
-        const std::vector<uint64_t> masks = footprintMasks(mesh, p, res, owners, charts);
         stats.sharedTexels += int64_t(sharedTexels(mesh, p, res, owners, charts));
-        gl::writeTexture(footprintCells.id(), 0, 0, p, res, res, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, masks.data());
+        {
+            const std::vector<TexelFootprint> footprints = texelFootprints(mesh, p, res, owners, charts);
+            std::vector<glm::uvec3> packed(footprints.size());
+            for (size_t i = 0; i < packed.size(); ++i) {
+                const TexelFootprint& f = footprints[i];
+                packed[i] = glm::uvec3(uint32_t(f.cells), uint32_t(f.cells >> 32), f.edge | uint32_t(f.area) << 24);
+            }
+            gl::writeTexture(footprint.id(), 0, 0, p, res, res, 1, GL_RGB_INTEGER, GL_UNSIGNED_INT, 12, packed.data());
+        }
         gl::writeTexture(chartNeighbours.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1,
                          neighbours.data());
         dilationCodes(codes, res, radius);
@@ -542,7 +549,7 @@ Status Baker::Impl::init(const Scene& scene) {
         direct = gl::Texture::create2DArray("direct light (fp16)", GL_RGBA16F, res, res, pages);
         dilation = gl::Texture::create2DArray("dilation codes", GL_R8UI, res, res, pages);
         chartNeighbours = gl::Texture::create2DArray("same-chart neighbours", GL_R8UI, res, res, pages);
-        footprintCells = gl::Texture::create2DArray("footprint cells on the chart", GL_RG32UI, res, res, pages);
+        footprint = gl::Texture::create2DArray("texel footprints on their charts", GL_RGB32UI, res, res, pages);
         texelCharts = gl::Texture::create2DArray("texel owners' charts", GL_R16UI, res, res, pages);
         readModes = gl::Texture::create2DArray("radiance read modes", GL_R8UI, res, res, stateLayers());
         accumAsFloat = gl::Texture::createView("accumulators as rg32f (direct light sums)", accum, GL_RG32F);
@@ -551,7 +558,7 @@ Status Baker::Impl::init(const Scene& scene) {
     }
     stats.lightmapStateBytes =
         accum.bytes() + radiance.bytes() + direct.bytes() + dilation.bytes() + chartNeighbours.bytes() + readModes.bytes() +
-        footprintCells.bytes() + texelCharts.bytes();
+        footprint.bytes() + texelCharts.bytes();
     {
         // the noise estimate's half: about 256^2 sampled texels a page, every texel of small pages
         MemoryCategory category("noise estimate");

@@ -52,14 +52,15 @@ struct Baker::Impl {
     // GL objects
     gl::Buffer vertexBuffer, triangleBuffer, metaIndexBuffer;
     gl::VertexArray vao;
-    // Light-map state, per page texel (33 bytes, 46 with back sides; BakeStats::memory):
+    // Light-map state, per page texel (37 bytes, 50 with back sides; BakeStats::memory):
     //   accum      RG32UI  the running mean of incoming radiance and its weight (lib/rounding.glsl's accumulator)
     //   radiance   RGB9_E5 outgoing radiance Lo the bundle pass samples (meta.frag writes it)
     //   direct     RGBA16F direct light L_lm (sun + explicit emitters)
     //   dilation   R8UI    the covered texel each texel shows (DILATION_* codes)
     //   chartNeighbours R8UI the texels 1 and 2 away along its row and column on its chart (CHART_NEIGHBOUR_*)
     //   readModes  R8UI    how the bundle pass reads the radiance inside the texel (READ_* per axis)
-    //   footprintCells RG32UI which eighth-texel cells of its square lie on its chart (footprintMasks)
+    //   footprint  RGB32UI which part of its square lies on its chart: eighth-texel cells, one more border
+    //                      edge and the part's area (texelFootprints)
     //   texelCharts R16UI  its owner's chart, low 16 bits (TRIANGLE_CHART_SHIFT; read by the bundle pass)
     // While the direct light is baked, its float sums live in views of accum
     // and radiance (lib/direct_scratch.glsl). Albedo and emission are not
@@ -68,7 +69,7 @@ struct Baker::Impl {
     // ceiling: its back reflects the ceiling's light onto it again), so a scene
     // with any has accum, radiance and readModes twice over: page p's back sides at layer
     // p + backLayerOffset (13 more bytes a texel; the direct light stays front-only).
-    gl::Texture accum, radiance, direct, dilation, chartNeighbours, readModes, footprintCells, texelCharts;
+    gl::Texture accum, radiance, direct, dilation, chartNeighbours, readModes, footprint, texelCharts;
     int backLayerOffset = 0;  // 0: no double-sided triangles, one layer per page
     int stateLayers() const { return layout.pageCount + backLayerOffset; }  // accum's and radiance's layers
     // The bundle and update programs handle back sides only when built with it:

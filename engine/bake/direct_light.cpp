@@ -107,7 +107,7 @@ void Baker::Impl::bakeSun() {
                 glUniform1f(program->uniform("depthBias"), depthBias);
                 glUniform1ui(program->uniform("footprintSample"), footprintSample);
             }
-            glBindTextureUnit(BINDING_FOOTPRINT_CELLS, footprintCells.id());
+            glBindTextureUnit(BINDING_FOOTPRINT, footprint.id());
             bindDirectSums(*this);
             glBindImageTexture(BINDING_DIRECT, direct.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA16F);
             return BundleTracer::UpdatePrograms{sunProgram.id(), curvedTexelCount() ? sunCurvedProgram.id() : 0u};
@@ -169,7 +169,7 @@ void addVisibleLight(Baker::Impl& m, const gl::Program& program, const gl::Progr
     }
     glBindTextureUnit(0, cube.cube.id());
     glBindTextureUnit(BINDING_TEXEL_CHARTS, m.texelCharts.id());
-    glBindTextureUnit(BINDING_FOOTPRINT_CELLS, m.footprintCells.id());
+    glBindTextureUnit(BINDING_FOOTPRINT, m.footprint.id());
     bindDirectSums(m);
     glBindFramebuffer(GL_FRAMEBUFFER, m.pageFbo.id());
     glViewport(0, 0, m.layout.resolution, m.layout.resolution);

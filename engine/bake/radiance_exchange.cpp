@@ -50,7 +50,7 @@ void Baker::Impl::beginDirection(int k) {
             glUniform1ui(program->uniform("footprintSample"), uint32_t(k));
         }
         glBindImageTexture(BINDING_HALF_ACCUM, halfAccum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
-        glBindTextureUnit(BINDING_FOOTPRINT_CELLS, footprintCells.id());
+        glBindTextureUnit(BINDING_FOOTPRINT, footprint.id());
         if (useEnv) glBindTextureUnit(BINDING_ENV, envTexture.id());
         glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
         return BundleTracer::UpdatePrograms{updateProgram.id(), curvedTexelCount() ? updateCurvedProgram.id() : 0u};

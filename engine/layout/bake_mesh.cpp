@@ -78,6 +78,18 @@ double polygonArea(const std::vector<glm::dvec2>& poly) {
     return 0.5 * area2;
 }
 
+// A convex polygon clipped to the half-plane n . p <= d (Sutherland-Hodgman).
+std::vector<glm::dvec2> clipHalfPlane(const std::vector<glm::dvec2>& poly, glm::dvec2 n, double d) {
+    std::vector<glm::dvec2> out;
+    for (size_t i = 0; i < poly.size(); ++i) {
+        const glm::dvec2 &p = poly[i], &q = poly[(i + 1) % poly.size()];
+        const double sp = d - glm::dot(n, p), sq = d - glm::dot(n, q);  // >= 0: inside
+        if (sp >= 0.0) out.push_back(p);
+        if ((sp >= 0.0) != (sq >= 0.0)) out.push_back(p + (q - p) * (sp / (sp - sq)));
+    }
+    return out;
+}
+
 }  // namespace
 
 std::vector<uint32_t> findLightmapCharts(const BakeMesh& mesh) {
@@ -198,19 +210,147 @@ std::vector<uint64_t> footprintMasks(const BakeMesh& mesh, int page, int res, co
     return mask;
 }
 
+double footprintEdgeAngle(int angle) { return angle * (6.283185307179586 / 4096.0); }
+
+uint32_t encodeFootprintEdge(int angle, double distance) {
+    // inward: the rounding, and a margin for the angle's (its 4096ths turn the
+    // line by up to 0.00077 rad about a point within 0.75 texel of the rest)
+    const int d = std::clamp(int(std::floor((distance - 0.0006 + 0.75) / 1.5 * 4095.0)), 0, 4095);
+    return std::max(uint32_t(angle & 4095) | uint32_t(d) << 12, 1u << 12);  // 0 stays "none"
+}
+
+bool insideFootprintEdge(uint32_t code, glm::dvec2 offset) {
+    if (code == 0) return true;
+    const float angle = float(code & 4095u) * (6.283185307f / 4096.0f);
+    const float distance = float(code >> 12) * (1.5f / 4095.0f) - 0.75f;
+    return std::cos(angle) * float(offset.x) + std::sin(angle) * float(offset.y) <= distance;
+}
+
+std::vector<TexelFootprint> texelFootprints(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,
+                                            const std::vector<uint32_t>& chart) {
+    const std::vector<uint64_t> mask = footprintMasks(mesh, page, res, owner, chart);
+    std::vector<TexelFootprint> out(mask.size());
+    // the chart's triangles over each texel only partly on it, by texel
+    std::vector<std::pair<uint32_t, uint32_t>> overlaps;  // (texel, triangle)
+    for (uint32_t t = mesh.pageFirstTriangle[size_t(page)]; t < mesh.pageFirstTriangle[size_t(page) + 1]; ++t) {
+        glm::dvec2 q[3];
+        const double absArea = pageCorners(mesh, t, res, q);
+        if (absArea == 0.0 || !std::isfinite(absArea)) continue;
+        const TexelRange r = texelsUnder(q, res);
+        for (int y = r.y0; y <= r.y1; ++y)
+            for (int x = r.x0; x <= r.x1; ++x) {
+                const size_t i = size_t(y) * res + x;
+                if (owner[i] >= 0 && mask[i] != ~uint64_t(0) && chart[size_t(owner[i])] == chart[t])
+                    overlaps.push_back({uint32_t(i), t});
+            }
+    }
+    std::sort(overlaps.begin(), overlaps.end());
+    // a triangle's corners in vertex order (its border bits' order), from a texel's centre
+    auto corners = [&](uint32_t t, glm::dvec2 centre, glm::dvec2 (&q)[3]) {
+        for (int k = 0; k < 3; ++k) q[k] = glm::dvec2(mesh.vertices[3 * size_t(t) + k].lightmapUv) * double(res) - centre;
+    };
+    auto cross = [](glm::dvec2 a, glm::dvec2 b) { return a.x * b.y - a.y * b.x; };
+    // whether p is on the inner side of edge e (opposite corner e) of q
+    auto within = [&](const glm::dvec2 (&q)[3], int e, glm::dvec2 p) {
+        return cross(q[(e + 2) % 3] - q[(e + 1) % 3], p - q[(e + 1) % 3]) * cross(q[1] - q[0], q[2] - q[0]) >= 0.0;
+    };
+    constexpr int N = 32;  // points a side: 4 x 4 a cell
+    std::vector<uint8_t> exact(N * N), base(N * N);
+    for (size_t begin = 0, end; begin < overlaps.size(); begin = end) {
+        const uint32_t i = overlaps[begin].first, o = uint32_t(owner[i]);
+        for (end = begin; end < overlaps.size() && overlaps[end].first == i; ++end) {}
+        const glm::dvec2 centre(double(i % uint32_t(res)) + 0.5, double(i / uint32_t(res)) + 0.5);
+        auto point = [](int k) { return glm::dvec2((k % N + 0.5) / N - 0.5, (k / N + 0.5) / N - 0.5); };
+        // on the chart (exact) and taken by the test without an edge (base)
+        glm::dvec2 own[3];
+        corners(o, centre, own);
+        const uint32_t ownBorders = (mesh.triangles[o].flags / TRIANGLE_CHART_BORDER0) & 7u;
+        for (int k = 0; k < N * N; ++k) {
+            const glm::dvec2 p = point(k);
+            bool on = (mask[i] >> ((k / N) * 8 / N * 8 + (k % N) * 8 / N)) & 1u;
+            for (int e = 0; e < 3 && on; ++e)
+                if (ownBorders & (1u << e)) on = within(own, e, p);
+            base[size_t(k)] = on;
+            exact[size_t(k)] = 0;
+            for (size_t j = begin; j < end && !exact[size_t(k)]; ++j) {
+                glm::dvec2 q[3];
+                corners(overlaps[j].second, centre, q);
+                exact[size_t(k)] = within(q, 0, p) && within(q, 1, p) && within(q, 2, p);
+            }
+        }
+        // the other triangles' border edges: the one that takes off the most
+        // points off the chart and none on it
+        uint32_t best = 0;
+        int bestScore = 0;
+        for (size_t j = begin; j < end; ++j) {
+            const uint32_t t = overlaps[j].second;
+            const uint32_t borders = (mesh.triangles[t].flags / TRIANGLE_CHART_BORDER0) & 7u;
+            if (t == o || borders == 0) continue;
+            glm::dvec2 q[3];
+            corners(t, centre, q);
+            for (int e = 0; e < 3; ++e) {
+                if (!(borders & (1u << e))) continue;
+                const glm::dvec2 a = q[(e + 1) % 3], b = q[(e + 2) % 3];
+                glm::dvec2 n(b.y - a.y, a.x - b.x);  // a normal; outward: away from corner e
+                if (glm::dot(n, q[e] - a) > 0.0) n = -n;
+                if (!(glm::length(n) > 0.0)) continue;
+                const int angle = int(std::lround(std::atan2(n.y, n.x) / 6.283185307179586 * 4096.0)) & 4095;
+                // through the edge's point nearest the centre, along the normal as encoded
+                const glm::dvec2 nq(std::cos(footprintEdgeAngle(angle)), std::sin(footprintEdgeAngle(angle)));
+                const glm::dvec2 ab = b - a;
+                const glm::dvec2 nearest = a + ab * std::clamp(glm::dot(-a, ab) / glm::dot(ab, ab), 0.0, 1.0);
+                const double distance = glm::dot(nq, nearest);
+                if (!(std::fabs(distance) < 0.75)) continue;
+                const uint32_t code = encodeFootprintEdge(angle, distance);
+                // points off the chart it takes off, less those on it (a sliver
+                // at most, the inward rounding's, or a concave chart's far part)
+                int score = 0;
+                for (int k = 0; k < N * N; ++k)
+                    if (base[size_t(k)] && !insideFootprintEdge(code, point(k))) score += exact[size_t(k)] ? -8 : 1;
+                if (score > bestScore) {
+                    best = code;
+                    bestScore = score;
+                }
+            }
+        }
+        // the accepted part's area, exactly: each cell clipped to the owner's
+        // border edges and the edge
+        std::vector<std::pair<glm::dvec2, double>> halfPlanes;  // n . p <= d
+        for (int e = 0; e < 3; ++e)
+            if (ownBorders & (1u << e)) {
+                const glm::dvec2 a = own[(e + 1) % 3], b = own[(e + 2) % 3];
+                glm::dvec2 n(b.y - a.y, a.x - b.x);
+                if (glm::dot(n, own[e] - a) > 0.0) n = -n;
+                halfPlanes.push_back({n, glm::dot(n, a)});
+            }
+        if (best != 0) {
+            const float angle = float(best & 4095u) * (6.283185307f / 4096.0f);
+            halfPlanes.push_back({glm::dvec2(std::cos(angle), std::sin(angle)), float(best >> 12) * (1.5f / 4095.0f) - 0.75f});
+        }
+        double accepted = 0.0;
+        for (int cell = 0; cell < 64; ++cell) {
+            if (!((mask[i] >> cell) & 1u)) continue;
+            const double x0 = (cell % 8) / 8.0 - 0.5, y0 = (cell / 8) / 8.0 - 0.5, s = 1.0 / 8.0;
+            std::vector<glm::dvec2> poly = {{x0, y0}, {x0 + s, y0}, {x0 + s, y0 + s}, {x0, y0 + s}};
+            for (const auto& [n, d] : halfPlanes) poly = clipHalfPlane(poly, n, d);
+            accepted += polygonArea(poly);
+        }
+        out[i].edge = best;
+        out[i].area = uint8_t(std::lround(255.0 * accepted));
+    }
+    for (size_t i = 0; i < mask.size(); ++i) {
+        out[i].cells = mask[i];
+        if (owner[i] >= 0 && mask[i] == ~uint64_t(0)) out[i].area = 255;
+    }
+    return out;
+}
+
 std::vector<glm::dvec2> clipSquare(const glm::dvec2 (&tri)[3]) {
-    std::vector<glm::dvec2> poly = {{0, 0}, {1, 0}, {1, 1}, {0, 1}}, next;
+    std::vector<glm::dvec2> poly = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
     for (int e = 0; e < 3 && !poly.empty(); ++e) {
         const glm::dvec2 a = tri[e], d = tri[(e + 1) % 3] - tri[e];
-        auto side = [&](const glm::dvec2& p) { return d.x * (p.y - a.y) - d.y * (p.x - a.x); };  // >= 0: inside
-        next.clear();
-        for (size_t i = 0; i < poly.size(); ++i) {
-            const glm::dvec2 &p = poly[i], &q = poly[(i + 1) % poly.size()];
-            const double sp = side(p), sq = side(q);
-            if (sp >= 0.0) next.push_back(p);
-            if ((sp >= 0.0) != (sq >= 0.0)) next.push_back(p + (q - p) * (sp / (sp - sq)));
-        }
-        poly.swap(next);
+        const glm::dvec2 n(d.y, -d.x);  // outward of a counter-clockwise triangle
+        poly = clipHalfPlane(poly, n, glm::dot(n, a));
     }
     return poly;
 }

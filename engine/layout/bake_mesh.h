@@ -84,6 +84,38 @@ std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res);
 std::vector<uint64_t> footprintMasks(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,
                                      const std::vector<uint32_t>& chart);
 
+// Each texel's footprint test (lib/texel_footprint.glsl offChart), one RGB32UI
+// texel of the footprint texture: a point of its square is on its chart where
+// it lies within the owner triangle's chart-border edges (exact), in a cell of
+// `cells` and inside `edge`.
+struct TexelFootprint {
+    uint64_t cells = 0;  // footprintMasks
+    // One more border of its part of the chart, where a cell the chart only
+    // partly covers would take in more than a few points off it: another
+    // triangle's chart-border edge (the far side of a strip narrower than a
+    // texel, whose near side the owner holds), a half-plane as
+    // insideFootprintEdge reads it (24 bits); 0: none.
+    uint32_t edge = 0;
+    // The part of its square the test accepts, in 255ths (measured on a 32 x
+    // 32 grid of points): the update pass expects a pixel centre to cross it
+    // about area x (its square's projection in pixels) times (footprintPixel).
+    uint8_t area = 0;
+};
+std::vector<TexelFootprint> texelFootprints(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,
+                                            const std::vector<uint32_t>& chart);
+
+// A half-plane of a texel's square as 24 bits: the low 12 the angle of its
+// outward normal n (4096ths of a turn), the high 12 its distance d from the
+// texel's centre (-0.75 + 1.5 x bits / 4095 texels); offsets o from the centre
+// with n . o <= d are inside. `distance` is for the normal at the encoded
+// angle, and rounds inward by up to 0.002 texel: a sliver of the chart is
+// left out rather than a sliver past its border taken in (past a ledge's far
+// border stands the wall it meets, whose fragments pass for the ledge's own
+// within the update pass's depth tolerance). 0 is none (everything inside).
+uint32_t encodeFootprintEdge(int angle, double distance);
+double footprintEdgeAngle(int angle);  // radians of an encoded angle (0..4095)
+bool insideFootprintEdge(uint32_t code, glm::dvec2 offset);
+
 // A texel whose footprint its owner's plane does not hold: its chart folds or
 // curves within its square (a chair's piping, a box's edge), so a point of the
 // square moved along the owner triangle's plane (lib/texel_footprint.glsl)

@@ -33,7 +33,7 @@ uniform bool emitterDoubleSided;
 uniform vec3 samplePoint;
 uniform int page;
 uniform uint footprintSample;              // this emitter sample's index over all emitters
-layout(binding = BINDING_FOOTPRINT_CELLS) uniform usampler2DArray footprintCells;
+layout(binding = BINDING_FOOTPRINT) uniform usampler2DArray footprint;
 const uint NEAR_FIELD_POINTS = 16u;  // F's points a sample within a texel of the emitter's plane
 #include "direct/footprint_point.glsl"
 

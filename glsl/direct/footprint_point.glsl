@@ -2,7 +2,7 @@
 // punctual.frag): the light map fragment's, along its triangle's plane
 // (lib/texel_footprint.glsl), or with CURVED_FOOTPRINT a curved texel's, on
 // the triangles that hold them (lib/curved_footprint.glsl).
-// Needs lib/texel_footprint.glsl, `page` and `footprintCells`.
+// Needs lib/texel_footprint.glsl, `page` and `footprint`.
 #ifdef CURVED_FOOTPRINT
 flat in uint vCurved;
 #include "lib/curved_footprint.glsl"
@@ -17,7 +17,7 @@ layout(binding = BINDING_TEXEL_CHARTS) uniform usampler2DArray texelCharts;
 
 struct TexelFootprint {
     ivec3 texel;
-    uvec2 cells;
+    uvec3 footprint;
     vec3 centre;  // the texel's centre on its surface
     float size;   // its size on the surface (the longer of its steps along x and y)
     // the light map fragment's steps per texel (flat texels)
@@ -33,7 +33,7 @@ struct FootprintPoint {
 bool texelFootprint(out TexelFootprint t) {
     uvec4 head = curvedTexels[vCurved];
     t.texel = ivec3(ivec2(gl_FragCoord.xy), int(head.y));
-    t.cells = texelFetch(footprintCells, t.texel, 0).rg;
+    t.footprint = texelFetch(footprint, t.texel, 0).rgb;
     t.centre = curvedTexelCentre(vCurved);
     CurvedTriangle owner = curvedTriangles[curvedRefs[head.z]];
     t.size = max(length(owner.positionDx.xyz), length(owner.positionDy.xyz));
@@ -43,7 +43,7 @@ bool texelFootprint(out TexelFootprint t) {
 FootprintPoint footprintPoint(TexelFootprint t, uint sampleIndex) {
     vec2 point;
     CurvedTriangle tri;
-    curvedFootprintPoint(vCurved, t.cells, sampleIndex, point, tri);
+    curvedFootprintPoint(vCurved, t.footprint.xy, sampleIndex, point, tri);
     vec2 q = point - tri.corners01.xy;
     return FootprintPoint(tri.position.xyz + tri.positionDx.xyz * q.x + tri.positionDy.xyz * q.y,
                           normalize(tri.normal.xyz + tri.normalDx.xyz * q.x + tri.normalDy.xyz * q.y),
@@ -62,14 +62,14 @@ bool texelFootprint(out TexelFootprint t) {
     if (gl_HelperInvocation) return false;
     t.texel = ivec3(ivec2(gl_FragCoord.xy), page);
     if ((texelFetch(texelCharts, t.texel, 0).r & TEXEL_CURVED) != 0u) return false;
-    t.cells = texelFetch(footprintCells, t.texel, 0).rg;
+    t.footprint = texelFetch(footprint, t.texel, 0).rgb;
     t.centre = vPosition;
     t.size = max(length(t.positionDx), length(t.positionDy));
     return true;
 }
 
 FootprintPoint footprintPoint(TexelFootprint t, uint sampleIndex) {
-    vec2 o = footprintOffset(vBary, t.baryDx, t.baryDy, vFlags, t.cells, sampleIndex);
+    vec2 o = footprintOffset(vBary, t.baryDx, t.baryDy, vFlags, t.footprint, sampleIndex);
     return FootprintPoint(vPosition + t.positionDx * o.x + t.positionDy * o.y,
                           normalize(vNormal + t.normalDx * o.x + t.normalDy * o.y), cross(t.positionDx, t.positionDy));
 }

@@ -14,7 +14,7 @@
 #include "lib/cube_visibility.glsl"
 #include "lib/direct_scratch.glsl"
 uniform int page;
-layout(binding = BINDING_FOOTPRINT_CELLS) uniform usampler2DArray footprintCells;
+layout(binding = BINDING_FOOTPRINT) uniform usampler2DArray footprint;
 #include "direct/footprint_point.glsl"
 
 const float PI = 3.14159265358979;

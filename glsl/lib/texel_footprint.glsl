@@ -27,19 +27,36 @@ bool cellOnChart(uvec2 cells, vec2 offset) {
     return (word & (1u << (bit & 31u))) != 0u;
 }
 
+// Whether `offset` (texels from the centre) lies inside the texel's one more
+// border edge (engine/layout/bake_mesh.h insideFootprintEdge, the same
+// arithmetic): `code`'s low 12 bits the angle of the outward normal, its high
+// 12 the distance; 0: none.
+bool insideFootprintEdge(uint code, vec2 offset) {
+    if (code == 0u) return true;
+    float angle = float(code & 4095u) * (6.283185307 / 4096.0);
+    float distance = float(code >> 12u) * (1.5 / 4095.0) - 0.75;
+    return cos(angle) * offset.x + sin(angle) * offset.y <= distance;
+}
+
+// The part of the texel's square the footprint test takes as on its chart (0..1).
+float footprintArea(uvec3 footprint) { return max(float(footprint.z >> 24u), 1.0) / 255.0; }
+
 // Whether the point `offset` texels from the fragment's centre lies off its
 // chart: past an edge of the fragment's triangle that is a chart border
-// (exact), or in an eighth-texel cell of the square no part of the chart
-// touches (`cells`: the texel's footprintMasks bits, engine/layout/bake_mesh.h,
-// low word first: the far borders, past the triangle's neighbours, to an
-// eighth of a texel).
+// (exact), in an eighth-texel cell of the square no part of the chart touches,
+// or past the texel's one more border edge (`footprint`: the texel's
+// texelFootprints record, engine/layout/bake_mesh.h: the cells, low word
+// first, and the edge in z's low 24 bits: the far borders, past the triangle's
+// neighbours, to an eighth of a texel, and the far side of a strip narrower
+// than a texel exactly).
 // bary: the fragment's barycentrics; baryDx, baryDy: their steps per texel
 // (dFdx, dFdy).
-bool offChart(vec3 bary, vec3 baryDx, vec3 baryDy, uint flags, uvec2 cells, vec2 offset) {
+bool offChart(vec3 bary, vec3 baryDx, vec3 baryDy, uint flags, uvec3 footprint, vec2 offset) {
     uint borders = (flags / TRIANGLE_CHART_BORDER0) & 7u;
     vec3 b = bary + baryDx * offset.x + baryDy * offset.y;
     return ((borders & 1u) != 0u && b.x < 0.0) || ((borders & 2u) != 0u && b.y < 0.0) ||
-           ((borders & 4u) != 0u && b.z < 0.0) || !cellOnChart(cells, offset);
+           ((borders & 4u) != 0u && b.z < 0.0) || !cellOnChart(footprint.xy, offset) ||
+           !insideFootprintEdge(footprint.z & 0xffffffu, offset);
 }
 
 // Candidate `attempt` of sample `sampleIndex`'s point, in texels from the
@@ -56,10 +73,10 @@ vec2 footprintCandidate(uint sampleIndex, int attempt) {
 }
 
 // Offset in texels of sample `sampleIndex`'s point, each coordinate in [-0.5, 0.5).
-vec2 footprintOffset(vec3 bary, vec3 baryDx, vec3 baryDy, uint flags, uvec2 cells, uint sampleIndex) {
+vec2 footprintOffset(vec3 bary, vec3 baryDx, vec3 baryDy, uint flags, uvec3 footprint, uint sampleIndex) {
     for (int attempt = 0; attempt < 8; ++attempt) {
         vec2 offset = footprintCandidate(sampleIndex, attempt);
-        if (!offChart(bary, baryDx, baryDy, flags, cells, offset)) return offset;
+        if (!offChart(bary, baryDx, baryDy, flags, footprint, offset)) return offset;
     }
     return vec2(0.0);
 }

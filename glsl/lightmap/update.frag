@@ -68,7 +68,7 @@ uniform int backLayerOffset;  // BACK_SIDES: double-sided triangles' back sides'
 uniform uint nodeCount;      // nodes in this tile's lists (END_OF_LIST is larger)
 uniform float depthBias;      // scene units: float precision floor
 uniform uint footprintSample; // this pass's sample of each texel's footprint (the direction's, the sun jitter's index)
-layout(binding = BINDING_FOOTPRINT_CELLS) uniform usampler2DArray footprintCells;
+layout(binding = BINDING_FOOTPRINT) uniform usampler2DArray footprint;
 #ifdef CURVED_FOOTPRINT
 #include "lib/curved_footprint.glsl"
 #endif
@@ -205,20 +205,27 @@ float ownCrossing(OwnSurface own, ivec2 pixel, vec2 offset) {
 // whose pixel hashes highest: the same pixels give the same choice whatever
 // the layout). Where the footprint projects to a pixel or more, the sample's
 // weight stays the direction's (`weight` 1): weighing it by how many
-// crossings the footprint holds (n / |det G|, exact in expectation) made the
-// weights noisy. Where it projects to less (a grazing direction), a pixel
-// centre crosses it only now and then, and the footprint's own point, which
-// stood in for it, read along a ray up to half a pixel beside it, 1 / cos of
-// that along the surface: a bias that did not fall with the directions (the
+// crossings the footprint holds (n / (area |det G|), exact in expectation)
+// made the weights noisy. Where it projects to less (a grazing direction), a
+// pixel centre crosses it only now and then, and the footprint's own point,
+// which stood in for it, read along a ray up to half a pixel beside it, 1 / cos
+// of that along the surface: a bias that did not fall with the directions (the
 // Cornell box's mean rose from +0.07 % at 1024 directions to +0.38 % at 4096).
-// There the sample weighs n / |det G| (Horvitz-Thompson: n crossings found,
-// |det G| expected), 0 when none is: false with `weight` 0, skip it.
+// There the sample weighs n / (area |det G|) (Horvitz-Thompson: n crossings
+// found, area |det G| expected), 0 when none is: false with `weight` 0, skip
+// it. `area` is the part of the square on the chart (texelFootprints): a
+// texel only partly on its chart (a 35 cm ledge in a 4 m texel of the city)
+// projects to less than a pixel in many more directions than its square
+// does, and taken at the square's |det G| those directions weighed a tenth of
+// the steep ones (the city's setback ledges and sills, sky light alone, 1024
+// directions: its upward texels on chart borders read +2.1 % of the scene's
+// mean too bright, +0.5 % with the area and texelFootprints' edge).
 // Where more than 6 x 6 centres might cross (a leaf much finer than the
 // texel, where the blur is small), or none does of a footprint a pixel or
 // more across (off its chart), false with `weight` 1: the footprint's own
 // point instead.
 bool footprintPixel(vec2 centre, vec3 positionDx, vec3 positionDy, vec3 bary, vec3 baryDx, vec3 baryDy, uint flags,
-                    uvec2 cells, uint seed, out vec2 offset, out float weight) {
+                    uvec3 onChart, uint seed, out vec2 offset, out float weight) {
     weight = 1.0;
     // columns: pixels per texel of offset along the light map's x and y
     mat2 G = mat2(vec2(dot(positionDx, bundleU), dot(positionDx, bundleV)),
@@ -234,7 +241,7 @@ bool footprintPixel(vec2 centre, vec3 positionDx, vec3 positionDy, vec3 bary, ve
     for (int y = lo.y; y <= hi.y; ++y)
         for (int x = lo.x; x <= hi.x; ++x) {
             vec2 o = offsetFromPixel * (vec2(x, y) + 0.5 - centre);
-            if (any(greaterThan(abs(o), vec2(0.5))) || offChart(bary, baryDx, baryDy, flags, cells, o)) continue;
+            if (any(greaterThan(abs(o), vec2(0.5))) || offChart(bary, baryDx, baryDy, flags, onChart, o)) continue;
             uint h = pcgHash(seed ^ (uint(x) * 0x9e3779b1u) ^ (uint(y) * 0x85ebca77u));
             ++crossings;
             if (!found || h > best) {
@@ -243,7 +250,7 @@ bool footprintPixel(vec2 centre, vec3 positionDx, vec3 positionDy, vec3 bary, ve
                 found = true;
             }
         }
-    float expected = abs(determinant(G));
+    float expected = abs(determinant(G)) * footprintArea(onChart);
     if (expected < 1.0) weight = float(crossings) / expected;
     return found;
 }
@@ -276,7 +283,7 @@ bool curvedSample(out TexelSample s) {
     if (!leafOwns(rootFromBundle(bundleFromWorld(curvedTexelCentre(vCurved)).xy))) return false;
     vec2 point;
     CurvedTriangle tri;
-    curvedFootprintPoint(vCurved, texelFetch(footprintCells, s.texel, 0).rg, footprintSample, point, tri);
+    curvedFootprintPoint(vCurved, texelFetch(footprint, s.texel, 0).xy, footprintSample, point, tri);
     vec2 q = point - tri.corners01.xy;
     s.position = tri.position.xyz + tri.positionDx.xyz * q.x + tri.positionDy.xyz * q.y;
     s.anchor = s.position;
@@ -320,13 +327,13 @@ bool triangleSample(out TexelSample s) {
     uint pixelSeed = pcgHash(randomSeed);
 #endif
     vec2 jitter;
-    uvec2 cells = texelFetch(footprintCells, s.texel, 0).rg;
-    if (!footprintPixel(gridFromRoot(centreRoot), positionDx, positionDy, vBary, baryDx, baryDy, vFlags, cells, pixelSeed,
-                        jitter, s.weight)) {
+    uvec3 onChart = texelFetch(footprint, s.texel, 0).rgb;
+    if (!footprintPixel(gridFromRoot(centreRoot), positionDx, positionDy, vBary, baryDx, baryDy, vFlags, onChart,
+                        pixelSeed, jitter, s.weight)) {
 #ifndef SUN_PASS
         if (s.weight == 0.0) return false;  // a grazing direction no pixel centre crossed the footprint in
 #endif
-        jitter = footprintOffset(vBary, baryDx, baryDy, vFlags, cells, footprintSample);
+        jitter = footprintOffset(vBary, baryDx, baryDy, vFlags, onChart, footprintSample);
 #ifdef SUN_PASS
         // The sun's sample is where its pixel's ray meets the surface: the pixel
         // (jittered from run to run, bakeSun) spreads it too, by up to half a

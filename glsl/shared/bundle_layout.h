@@ -49,7 +49,7 @@ struct Node {
 #define BINDING_ENV 1            // texture unit: environment map (equirectangular)
 #define BINDING_MATERIAL_TEX 2   // texture unit: a material's albedo texture (emission: + 1)
 #define BINDING_READ_MODES 4     // texture unit: r8ui per texel: READ_* per axis (lightmap/read_modes.comp)
-#define BINDING_FOOTPRINT_CELLS 5  // texture unit: rg32ui per texel: its square's 8 x 8 cells on its chart (footprintMasks)
+#define BINDING_FOOTPRINT 5       // texture unit: rgb32ui per texel: its square's part on its chart (texelFootprints)
 #define BINDING_TEXEL_CHARTS 6   // texture unit: r16ui per texel: its owner's chart, low 15 bits, and TEXEL_CURVED (mesh_layout.h)
 #define BINDING_CHART_NEIGHBOURS_IMAGE 6  // image unit, read-modes pass only (the dilation's unit elsewhere)
 #define BINDING_READ_MODES_IMAGE 7        // image unit, read-modes pass only (the resolve target's unit elsewhere)

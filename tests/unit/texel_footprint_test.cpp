@@ -1,0 +1,72 @@
+// A texel's footprint test (layout/bake_mesh.h texelFootprints, read by
+// lib/texel_footprint.glsl offChart): the part of its square on its chart.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "layout/bake_mesh.h"
+
+namespace bb {
+namespace {
+
+// A strip 0.1 texel wide across texels 2..5 of row 5 of a 16 x 16 page (v
+// from 5.455 to 5.555, both inside the cell row [5.5, 5.625) or next to it),
+// one quad split along (2, 5.455)-(6, 5.555): the texels' centres lie on the
+// triangle of the near edge (v = 5.455) in texels 4 and 5, on the far edge's
+// in texels 2 and 3. The chart-border flags as buildBakeMesh sets them.
+BakeMesh stripMesh() {
+    BakeMesh m;
+    const glm::vec2 o0(2, 5.455f), o1(6, 5.455f), w0(2, 5.555f), w1(6, 5.555f);
+    // (corners, border edges: bit k for the edge opposite corner k)
+    const std::pair<std::array<glm::vec2, 3>, uint32_t> tris[2] = {{{o0, o1, w1}, 1u | 4u}, {{o0, w1, w0}, 1u | 2u}};
+    for (const auto& [corners, borders] : tris) {
+        for (const glm::vec2& c : corners) {
+            BakeVertex v;
+            v.position = glm::vec4(c, 0, 1);
+            v.normal = glm::vec4(0, 0, 1, 0);
+            v.lightmapUv = c / 16.0f;
+            m.vertices.push_back(v);
+        }
+        m.triangles.push_back({0, 0, 0, borders * TRIANGLE_CHART_BORDER0});
+    }
+    m.pageFirstTriangle = {0, 2};
+    return m;
+}
+
+// Every texel takes 0.1 of its square: the cells alone take the whole cell
+// row past the far edge (0.17 of the square where the near edge's triangle
+// owns the texel), and the far edge (the other triangle's) is what cuts it.
+TEST(TexelFootprints, AStripNarrowerThanATexelTakesItsOwnWidth) {
+    const BakeMesh m = stripMesh();
+    const std::vector<int32_t> owners = texelOwners(m, 0, 16);
+    const std::vector<TexelFootprint> f = texelFootprints(m, 0, 16, owners, findLightmapCharts(m));
+    for (int x = 2; x < 6; ++x) {
+        const size_t i = 5 * 16 + size_t(x);
+        ASSERT_GE(owners[i], 0) << "texel " << x;
+        std::printf("[footprint] texel %d: owner %d, area %.3f, edge %06x\n", x, owners[i], f[i].area / 255.0,
+                    f[i].edge);
+        EXPECT_NEAR(f[i].area / 255.0, 0.1, 0.005) << "texel " << x;
+    }
+    EXPECT_EQ(owners[5 * 16 + 5], 0) << "the near edge's triangle owns texel 5";
+    EXPECT_NE(f[5 * 16 + 5].edge, 0u) << "the far edge cuts texel 5's cells";
+}
+
+// The half-plane's encoding rounds inward: points up to 0.002 texel inside
+// its line may be left out, none past it is taken in.
+TEST(TexelFootprints, EdgeEncodingRoundsInward) {
+    for (int angle : {0, 700, 1024, 2500, 4095})
+        for (double distance : {-0.6, -0.1, 0.0, 0.237, 0.7}) {
+            const uint32_t code = encodeFootprintEdge(angle, distance);
+            const glm::dvec2 n(std::cos(footprintEdgeAngle(angle)), std::sin(footprintEdgeAngle(angle)));
+            const glm::dvec2 t(-n.y, n.x);
+            for (double along : {-0.7, 0.0, 0.7}) {
+                EXPECT_FALSE(insideFootprintEdge(code, n * (distance + 1e-4) + t * along)) << angle << " " << distance;
+                EXPECT_TRUE(insideFootprintEdge(code, n * (distance - 0.002) + t * along)) << angle << " " << distance;
+            }
+        }
+    EXPECT_TRUE(insideFootprintEdge(0u, glm::dvec2(0.5, 0.5)));  // no edge
+}
+
+}  // namespace
+}  // namespace bb
