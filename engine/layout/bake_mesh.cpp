@@ -219,11 +219,18 @@ uint32_t encodeFootprintEdge(int angle, double distance) {
     return std::max(uint32_t(angle & 4095) | uint32_t(d) << 12, 1u << 12);  // 0 stays "none"
 }
 
+namespace {
+// An edge's half-plane n . p <= d, decoded as lib/texel_footprint.glsl does (in float).
+std::pair<glm::dvec2, double> decodeFootprintEdge(uint32_t code) {
+    const float angle = float(code & 4095u) * (6.283185307f / 4096.0f);
+    return {glm::dvec2(std::cos(angle), std::sin(angle)), float(code >> 12) * (1.5f / 4095.0f) - 0.75f};
+}
+}  // namespace
+
 bool insideFootprintEdge(uint32_t code, glm::dvec2 offset) {
     if (code == 0) return true;
-    const float angle = float(code & 4095u) * (6.283185307f / 4096.0f);
-    const float distance = float(code >> 12) * (1.5f / 4095.0f) - 0.75f;
-    return std::cos(angle) * float(offset.x) + std::sin(angle) * float(offset.y) <= distance;
+    const auto [n, d] = decodeFootprintEdge(code);
+    return glm::dot(n, offset) <= d;
 }
 
 std::vector<TexelFootprint> texelFootprints(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,
@@ -249,10 +256,16 @@ std::vector<TexelFootprint> texelFootprints(const BakeMesh& mesh, int page, int 
     auto corners = [&](uint32_t t, glm::dvec2 centre, glm::dvec2 (&q)[3]) {
         for (int k = 0; k < 3; ++k) q[k] = glm::dvec2(mesh.vertices[3 * size_t(t) + k].lightmapUv) * double(res) - centre;
     };
-    auto cross = [](glm::dvec2 a, glm::dvec2 b) { return a.x * b.y - a.y * b.x; };
-    // whether p is on the inner side of edge e (opposite corner e) of q
+    // edge e of q (opposite corner e) as the half-plane n . p <= d that holds q, n outward
+    auto edgeHalfPlane = [](const glm::dvec2 (&q)[3], int e) {
+        const glm::dvec2 a = q[(e + 1) % 3], b = q[(e + 2) % 3];
+        glm::dvec2 n(b.y - a.y, a.x - b.x);
+        if (glm::dot(n, q[e] - a) > 0.0) n = -n;
+        return std::pair<glm::dvec2, double>(n, glm::dot(n, a));
+    };
     auto within = [&](const glm::dvec2 (&q)[3], int e, glm::dvec2 p) {
-        return cross(q[(e + 2) % 3] - q[(e + 1) % 3], p - q[(e + 1) % 3]) * cross(q[1] - q[0], q[2] - q[0]) >= 0.0;
+        const auto [n, d] = edgeHalfPlane(q, e);
+        return glm::dot(n, p) <= d;
     };
     constexpr int N = 32;  // points a side: 4 x 4 a cell
     std::vector<uint8_t> exact(N * N), base(N * N);
@@ -290,9 +303,7 @@ std::vector<TexelFootprint> texelFootprints(const BakeMesh& mesh, int page, int 
             corners(t, centre, q);
             for (int e = 0; e < 3; ++e) {
                 if (!(borders & (1u << e))) continue;
-                const glm::dvec2 a = q[(e + 1) % 3], b = q[(e + 2) % 3];
-                glm::dvec2 n(b.y - a.y, a.x - b.x);  // a normal; outward: away from corner e
-                if (glm::dot(n, q[e] - a) > 0.0) n = -n;
+                const glm::dvec2 a = q[(e + 1) % 3], b = q[(e + 2) % 3], n = edgeHalfPlane(q, e).first;
                 if (!(glm::length(n) > 0.0)) continue;
                 const int angle = int(std::lround(std::atan2(n.y, n.x) / 6.283185307179586 * 4096.0)) & 4095;
                 // through the edge's point nearest the centre, along the normal as encoded
@@ -315,18 +326,10 @@ std::vector<TexelFootprint> texelFootprints(const BakeMesh& mesh, int page, int 
         }
         // the accepted part's area, exactly: each cell clipped to the owner's
         // border edges and the edge
-        std::vector<std::pair<glm::dvec2, double>> halfPlanes;  // n . p <= d
+        std::vector<std::pair<glm::dvec2, double>> halfPlanes;
         for (int e = 0; e < 3; ++e)
-            if (ownBorders & (1u << e)) {
-                const glm::dvec2 a = own[(e + 1) % 3], b = own[(e + 2) % 3];
-                glm::dvec2 n(b.y - a.y, a.x - b.x);
-                if (glm::dot(n, own[e] - a) > 0.0) n = -n;
-                halfPlanes.push_back({n, glm::dot(n, a)});
-            }
-        if (best != 0) {
-            const float angle = float(best & 4095u) * (6.283185307f / 4096.0f);
-            halfPlanes.push_back({glm::dvec2(std::cos(angle), std::sin(angle)), float(best >> 12) * (1.5f / 4095.0f) - 0.75f});
-        }
+            if (ownBorders & (1u << e)) halfPlanes.push_back(edgeHalfPlane(own, e));
+        if (best != 0) halfPlanes.push_back(decodeFootprintEdge(best));
         double accepted = 0.0;
         for (int cell = 0; cell < 64; ++cell) {
             if (!((mask[i] >> cell) & 1u)) continue;
