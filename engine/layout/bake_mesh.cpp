@@ -10,6 +10,7 @@
 #include "layout/bake_mesh.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <numeric>
@@ -263,33 +264,38 @@ std::vector<TexelFootprint> texelFootprints(const BakeMesh& mesh, int page, int 
         if (glm::dot(n, q[e] - a) > 0.0) n = -n;
         return std::pair<glm::dvec2, double>(n, glm::dot(n, a));
     };
-    auto within = [&](const glm::dvec2 (&q)[3], int e, glm::dvec2 p) {
-        const auto [n, d] = edgeHalfPlane(q, e);
-        return glm::dot(n, p) <= d;
+    auto within = [](const std::pair<glm::dvec2, double>& halfPlane, glm::dvec2 p) {
+        return glm::dot(halfPlane.first, p) <= halfPlane.second;
     };
     constexpr int N = 32;  // points a side: 4 x 4 a cell
     std::vector<uint8_t> exact(N * N), base(N * N);
+    std::vector<std::array<std::pair<glm::dvec2, double>, 3>> sides;  // the texel's triangles' edges
     for (size_t begin = 0, end; begin < overlaps.size(); begin = end) {
         const uint32_t i = overlaps[begin].first, o = uint32_t(owner[i]);
         for (end = begin; end < overlaps.size() && overlaps[end].first == i; ++end) {}
         const glm::dvec2 centre(double(i % uint32_t(res)) + 0.5, double(i / uint32_t(res)) + 0.5);
         auto point = [](int k) { return glm::dvec2((k % N + 0.5) / N - 0.5, (k / N + 0.5) / N - 0.5); };
         // on the chart (exact) and taken by the test without an edge (base)
+        const uint32_t ownBorders = (mesh.triangles[o].flags / TRIANGLE_CHART_BORDER0) & 7u;
+        sides.clear();
+        for (size_t j = begin; j < end; ++j) {
+            glm::dvec2 q[3];
+            corners(overlaps[j].second, centre, q);
+            sides.push_back({edgeHalfPlane(q, 0), edgeHalfPlane(q, 1), edgeHalfPlane(q, 2)});
+        }
         glm::dvec2 own[3];
         corners(o, centre, own);
-        const uint32_t ownBorders = (mesh.triangles[o].flags / TRIANGLE_CHART_BORDER0) & 7u;
+        const std::array<std::pair<glm::dvec2, double>, 3> ownSides = {edgeHalfPlane(own, 0), edgeHalfPlane(own, 1),
+                                                                        edgeHalfPlane(own, 2)};
         for (int k = 0; k < N * N; ++k) {
             const glm::dvec2 p = point(k);
             bool on = (mask[i] >> ((k / N) * 8 / N * 8 + (k % N) * 8 / N)) & 1u;
             for (int e = 0; e < 3 && on; ++e)
-                if (ownBorders & (1u << e)) on = within(own, e, p);
+                if (ownBorders & (1u << e)) on = within(ownSides[size_t(e)], p);
             base[size_t(k)] = on;
             exact[size_t(k)] = 0;
-            for (size_t j = begin; j < end && !exact[size_t(k)]; ++j) {
-                glm::dvec2 q[3];
-                corners(overlaps[j].second, centre, q);
-                exact[size_t(k)] = within(q, 0, p) && within(q, 1, p) && within(q, 2, p);
-            }
+            for (size_t j = 0; j < sides.size() && !exact[size_t(k)]; ++j)
+                exact[size_t(k)] = within(sides[j][0], p) && within(sides[j][1], p) && within(sides[j][2], p);
         }
         // the other triangles' border edges: the one that takes off the most
         // points off the chart and none on it
@@ -315,9 +321,10 @@ std::vector<TexelFootprint> texelFootprints(const BakeMesh& mesh, int page, int 
                 const uint32_t code = encodeFootprintEdge(angle, distance);
                 // points off the chart it takes off, less those on it (a sliver
                 // at most, the inward rounding's, or a concave chart's far part)
+                const auto side = decodeFootprintEdge(code);
                 int score = 0;
                 for (int k = 0; k < N * N; ++k)
-                    if (base[size_t(k)] && !insideFootprintEdge(code, point(k))) score += exact[size_t(k)] ? -8 : 1;
+                    if (base[size_t(k)] && !within(side, point(k))) score += exact[size_t(k)] ? -8 : 1;
                 if (score > bestScore) {
                     best = code;
                     bestScore = score;
@@ -328,7 +335,7 @@ std::vector<TexelFootprint> texelFootprints(const BakeMesh& mesh, int page, int 
         // border edges and the edge
         std::vector<std::pair<glm::dvec2, double>> halfPlanes;
         for (int e = 0; e < 3; ++e)
-            if (ownBorders & (1u << e)) halfPlanes.push_back(edgeHalfPlane(own, e));
+            if (ownBorders & (1u << e)) halfPlanes.push_back(ownSides[size_t(e)]);
         if (best != 0) halfPlanes.push_back(decodeFootprintEdge(best));
         double accepted = 0.0;
         for (int cell = 0; cell < 64; ++cell) {

@@ -40,12 +40,15 @@ bool curvedTriangleHolds(CurvedTriangle c, vec2 p) {
     return all(greaterThanEqual(w * sign(area), vec3(0.0)));
 }
 
+// A curved texel's square's centre in page texels (`head`: its first uvec4).
+vec2 curvedTexelSquareCentre(uvec4 head) { return vec2(head.x & 0xffffu, head.x >> 16u) + 0.5; }
+
 // Curved texel `index`'s centre on its owner triangle (the first of its
 // triangles, which holds the centre): where the leaf that takes its samples is.
 vec3 curvedTexelCentre(uint index) {
     uvec4 head = curvedTexels[index];
     CurvedTriangle owner = curvedTriangles[curvedRefs[head.z]];
-    vec2 q = vec2(head.x & 0xffffu, head.x >> 16u) + 0.5 - owner.corners01.xy;
+    vec2 q = curvedTexelSquareCentre(head) - owner.corners01.xy;
     return owner.position.xyz + owner.positionDx.xyz * q.x + owner.positionDy.xyz * q.y;
 }
 
@@ -55,7 +58,7 @@ vec3 curvedTexelCentre(uint index) {
 // After 8 candidates the centre, which the owner holds.
 void curvedFootprintPoint(uint index, uvec2 cells, uint sampleIndex, out vec2 point, out CurvedTriangle tri) {
     uvec4 head = curvedTexels[index];
-    vec2 centre = vec2(head.x & 0xffffu, head.x >> 16u) + 0.5;
+    vec2 centre = curvedTexelSquareCentre(head);
     for (int attempt = 0; attempt < 8; ++attempt) {
         vec2 offset = footprintCandidate(sampleIndex, attempt);
         if (!cellOnChart(cells, offset)) continue;

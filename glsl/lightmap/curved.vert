@@ -13,8 +13,7 @@ uniform int pageResolution;
 flat out uint vCurved;
 
 void main() {
-    uint texelBits = curvedTexels[gl_VertexID].x;
-    vec2 centre = vec2(texelBits & 0xffffu, texelBits >> 16u) + 0.5;
+    vec2 centre = curvedTexelSquareCentre(curvedTexels[gl_VertexID]);
     gl_Position = vec4(centre / float(pageResolution) * 2.0 - 1.0, 0.0, 1.0);
     gl_PointSize = 1.0;
     vCurved = uint(gl_VertexID);
