@@ -268,13 +268,13 @@ std::vector<TexelFootprint> texelFootprints(const BakeMesh& mesh, int page, int 
         return glm::dot(halfPlane.first, p) <= halfPlane.second;
     };
     constexpr int N = 32;  // points a side: 4 x 4 a cell
+    auto point = [](int k) { return glm::dvec2((k % N + 0.5) / N - 0.5, (k / N + 0.5) / N - 0.5); };
     std::vector<uint8_t> exact(N * N), base(N * N);
     std::vector<std::array<std::pair<glm::dvec2, double>, 3>> sides;  // the texel's triangles' edges
     for (size_t begin = 0, end; begin < overlaps.size(); begin = end) {
         const uint32_t i = overlaps[begin].first, o = uint32_t(owner[i]);
         for (end = begin; end < overlaps.size() && overlaps[end].first == i; ++end) {}
         const glm::dvec2 centre(double(i % uint32_t(res)) + 0.5, double(i / uint32_t(res)) + 0.5);
-        auto point = [](int k) { return glm::dvec2((k % N + 0.5) / N - 0.5, (k / N + 0.5) / N - 0.5); };
         // on the chart (exact) and taken by the test without an edge (base)
         const uint32_t ownBorders = (mesh.triangles[o].flags / TRIANGLE_CHART_BORDER0) & 7u;
         sides.clear();
@@ -285,13 +285,14 @@ std::vector<TexelFootprint> texelFootprints(const BakeMesh& mesh, int page, int 
         }
         glm::dvec2 own[3];
         corners(o, centre, own);
-        const std::array<std::pair<glm::dvec2, double>, 3> ownSides = {edgeHalfPlane(own, 0), edgeHalfPlane(own, 1),
-                                                                        edgeHalfPlane(own, 2)};
+        // the owner's chart-border edges (then the one more edge, for the area)
+        std::vector<std::pair<glm::dvec2, double>> halfPlanes;
+        for (int e = 0; e < 3; ++e)
+            if (ownBorders & (1u << e)) halfPlanes.push_back(edgeHalfPlane(own, e));
         for (int k = 0; k < N * N; ++k) {
             const glm::dvec2 p = point(k);
             bool on = (mask[i] >> ((k / N) * 8 / N * 8 + (k % N) * 8 / N)) & 1u;
-            for (int e = 0; e < 3 && on; ++e)
-                if (ownBorders & (1u << e)) on = within(ownSides[size_t(e)], p);
+            for (size_t h = 0; h < halfPlanes.size() && on; ++h) on = within(halfPlanes[h], p);
             base[size_t(k)] = on;
             exact[size_t(k)] = 0;
             for (size_t j = 0; j < sides.size() && !exact[size_t(k)]; ++j)
@@ -309,7 +310,7 @@ std::vector<TexelFootprint> texelFootprints(const BakeMesh& mesh, int page, int 
             corners(t, centre, q);
             for (int e = 0; e < 3; ++e) {
                 if (!(borders & (1u << e))) continue;
-                const glm::dvec2 a = q[(e + 1) % 3], b = q[(e + 2) % 3], n = edgeHalfPlane(q, e).first;
+                const glm::dvec2 a = q[(e + 1) % 3], b = q[(e + 2) % 3], n = sides[j - begin][size_t(e)].first;
                 if (!(glm::length(n) > 0.0)) continue;
                 const int angle = int(std::lround(std::atan2(n.y, n.x) / 6.283185307179586 * 4096.0)) & 4095;
                 // through the edge's point nearest the centre, along the normal as encoded
@@ -333,9 +334,6 @@ std::vector<TexelFootprint> texelFootprints(const BakeMesh& mesh, int page, int 
         }
         // the accepted part's area, exactly: each cell clipped to the owner's
         // border edges and the edge
-        std::vector<std::pair<glm::dvec2, double>> halfPlanes;
-        for (int e = 0; e < 3; ++e)
-            if (ownBorders & (1u << e)) halfPlanes.push_back(ownSides[size_t(e)]);
         if (best != 0) halfPlanes.push_back(decodeFootprintEdge(best));
         double accepted = 0.0;
         for (int cell = 0; cell < 64; ++cell) {
