@@ -375,7 +375,8 @@ def scene_hash(cfg, flags):
         with open(path, "rb") as f:
             h.update(hashlib.sha256(f.read()).digest())
     h.update(" ".join(flags).encode())
-    for src in ("engine/reference/reference_baker.cpp", "engine/reference/reference_baker.h"):
+    for src in ("engine/reference/reference_baker.cpp", "engine/reference/reference_baker.h",
+                "engine/layout/bake_mesh.cpp", "engine/layout/bake_mesh.h"):
         with open(os.path.join(ROOT, src), "rb") as f:
             h.update(f.read())
     return h.hexdigest()[:16]

@@ -121,11 +121,12 @@ nlohmann::json BakeStats::toJson() const {
                    {"lightmap_state_bytes", lightmapStateBytes},
                    {"lightmap_bytes_per_page_texel", double(lightmapStateBytes) / pageTexels},
                    {"lightmap_bytes_per_covered_texel", double(lightmapStateBytes) / coveredTexelsOrOne},
+                   {"curved_texel_bytes", curvedTexelBytes},
                    {"by_category", categories},
                    {"node_capacity", nodeCapacity}, {"peak_nodes_per_tile", peakNodesPerTile},
                    {"node_buffer_bytes", nodeBufferBytes}, {"head_image_bytes", headImageBytes}, {"bytes_per_node", 12}};
     j["lightmap"] = {{"texels", lightmapTexels}, {"covered_texels", coveredTexels}, {"shared_texels", sharedTexels},
-                   {"curved_texels", curvedTexels}};
+                   {"curved_texels", curvedTexels}, {"partial_texels", partialTexels}};
     j["direct_light"] = {{"explicit_emitters", explicitEmitters}, {"emitter_samples", emitterSampleCount}};
     double bundleSeconds = secondsBundle > 0 ? secondsBundle : 1e-9;
     double updateSeconds = secondsUpdate > 0 ? secondsUpdate : 1e-9;
@@ -258,7 +259,6 @@ void Baker::Impl::uploadMaterials(const Scene& scene) {
 
 void Baker::Impl::drawSurface(GLuint program, bool materialUniforms) {
     glUseProgram(program);
-    glBindVertexArray(vao.id());  // meta.vert reads attributes only: no per-triangle SSBO to chunk
     glBindFramebuffer(GL_FRAMEBUFFER, pageFbo.id());
     glViewport(0, 0, layout.resolution, layout.resolution);
     const GLint pageUniform = glGetUniformLocation(program, "page");
@@ -267,25 +267,76 @@ void Baker::Impl::drawSurface(GLuint program, bool materialUniforms) {
     const GLint hasAlbedoUniform = glGetUniformLocation(program, "hasAlbedoTexture");
     const GLint hasEmissionUniform = glGetUniformLocation(program, "hasEmissionTexture");
     const GLint materialUniform = glGetUniformLocation(program, "material");  // cut-outs (coverage)
-    for (const SurfaceRun& run : surfaceRuns) {
+    auto setRun = [&](const SurfaceRun& run) {
         glUniform1i(pageUniform, GLint(run.page));
         glUniform1i(materialUniform, GLint(run.material));
-        if (materialUniforms) {
-            const Material& mat = materials[run.material];
-            glUniform3fv(albedoUniform, 1, &mat.albedo.x);
-            const glm::vec3 emission = mat.emission / radianceUnit;
-            glUniform3fv(emissionUniform, 1, &emission.x);
-            glUniform1i(hasAlbedoUniform, mat.albedoTexture >= 0);
-            glUniform1i(hasEmissionUniform, mat.emissionTexture >= 0);
-            if (mat.albedoTexture >= 0) glBindTextureUnit(BINDING_MATERIAL_TEX, materialTextures[mat.albedoTexture].id());
-            if (mat.emissionTexture >= 0)
-                glBindTextureUnit(BINDING_MATERIAL_TEX + 1, materialTextures[mat.emissionTexture].id());
-        }
+        if (!materialUniforms) return;
+        const Material& mat = materials[run.material];
+        glUniform3fv(albedoUniform, 1, &mat.albedo.x);
+        const glm::vec3 emission = mat.emission / radianceUnit;
+        glUniform3fv(emissionUniform, 1, &emission.x);
+        glUniform1i(hasAlbedoUniform, mat.albedoTexture >= 0);
+        glUniform1i(hasEmissionUniform, mat.emissionTexture >= 0);
+        if (mat.albedoTexture >= 0) glBindTextureUnit(BINDING_MATERIAL_TEX, materialTextures[mat.albedoTexture].id());
+        if (mat.emissionTexture >= 0) glBindTextureUnit(BINDING_MATERIAL_TEX + 1, materialTextures[mat.emissionTexture].id());
+    };
+    glBindVertexArray(vao.id());  // meta.vert reads attributes only: no per-triangle SSBO to chunk
+    for (const SurfaceRun& run : surfaceRuns) {
+        setRun(run);
         glDrawElements(GL_TRIANGLES, GLsizei(run.count * 3), GL_UNSIGNED_INT,
                        reinterpret_cast<const void*>(uintptr_t(run.first) * 3 * sizeof(uint32_t)));
     }
+    if (!partialRuns.empty()) glBindVertexArray(partialPointArray.id());
+    for (const SurfaceRun& run : partialRuns) {
+        setRun(run);
+        glDrawArrays(GL_POINTS, GLint(run.first), GLsizei(run.count));
+    }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+}
+
+void Baker::Impl::uploadPartialPoints() {
+    const int res = layout.resolution;
+    std::vector<BakeVertex> points;
+    for (int p = 0; p < layout.pageCount; ++p) {
+        std::vector<uint8_t> partial;
+        const std::vector<int32_t> owners = texelOwners(mesh, p, res, &partial);
+        std::vector<std::pair<uint32_t, BakeVertex>> page;  // (material, point)
+        for (size_t i = 0; i < owners.size(); ++i) {
+            if (!partial[i]) continue;
+            const uint32_t t = uint32_t(owners[i]);
+            const BakeVertex* v = &mesh.vertices[3 * size_t(t)];
+            // the owner's point nearest the centre, near enough: its barycentrics clamped
+            const glm::dvec2 c(double(i % size_t(res)) + 0.5, double(i / size_t(res)) + 0.5);
+            glm::dvec2 q[3];
+            for (int k = 0; k < 3; ++k) q[k] = glm::dvec2(v[k].lightmapUv) * double(res);
+            const double det = (q[1].x - q[0].x) * (q[2].y - q[0].y) - (q[1].y - q[0].y) * (q[2].x - q[0].x);
+            const double b1 = ((c.x - q[0].x) * (q[2].y - q[0].y) - (c.y - q[0].y) * (q[2].x - q[0].x)) / det;
+            const double b2 = ((q[1].x - q[0].x) * (c.y - q[0].y) - (q[1].y - q[0].y) * (c.x - q[0].x)) / det;
+            glm::dvec3 b = glm::max(glm::dvec3(1.0 - b1 - b2, b1, b2), glm::dvec3(0.0));
+            b /= b.x + b.y + b.z;
+            BakeVertex point{};
+            for (int k = 0; k < 3; ++k) {
+                point.position += v[k].position * float(b[k]);
+                point.normal += v[k].normal * float(b[k]);
+                point.uv0 += v[k].uv0 * float(b[k]);
+            }
+            point.lightmapUv = glm::vec2(c / double(res));
+            page.emplace_back(mesh.triangles[t].material, point);
+        }
+        std::stable_sort(page.begin(), page.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+        for (const auto& [material, point] : page) {
+            if (partialRuns.empty() || partialRuns.back().page != uint32_t(p) || partialRuns.back().material != material)
+                partialRuns.push_back({points.size(), 0, uint32_t(p), material});
+            ++partialRuns.back().count;
+            points.push_back(point);
+        }
+    }
+    if (points.empty()) return;
+    MemoryCategory category("mesh");
+    partialPointBuffer = gl::Buffer::create("partial texels' points", int64_t(points.size() * sizeof(BakeVertex)),
+                                            points.data(), 0);
+    partialPointArray = createBakeVertexArray("partial texels' points", partialPointBuffer);
 }
 
 void Baker::Impl::coveragePass() {
@@ -294,6 +345,7 @@ void Baker::Impl::coveragePass() {
     glClearTexImage(dilation.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_BYTE, &none);
     glBindImageTexture(BINDING_DILATION, dilation.id(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R8UI);
     bindAlphaMasks();  // a cut-away texel centre is not covered
+    uploadPartialPoints();
     drawSurface(coverageProgram.id(), false);
     // padding: the nearest covered texel, page by page on the CPU (once)
     const int res = layout.resolution;
@@ -307,17 +359,22 @@ void Baker::Impl::coveragePass() {
     int64_t curvedRefs = 0, flatInstead = 0;
     for (int p = 0; p < layout.pageCount; ++p) {
         gl::readTexture(dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, codes.data());
-        stats.coveredTexels += std::count(codes.begin(), codes.end(), uint8_t(DILATION_SELF));
-        const std::vector<int32_t> owners = texelOwners(mesh, p, res);
-        chartNeighbourBits(codes, owners, charts, res, neighbours);
-        curved[size_t(p)] = curvedTexels(mesh, p, res, owners, charts);
+        std::vector<uint8_t> partial;
+        const std::vector<int32_t> owners = texelOwners(mesh, p, res, &partial);
+        curved[size_t(p)] = curvedTexels(mesh, p, res, owners, charts, partial);
         std::erase_if(curved[size_t(p)], [&](const CurvedTexel& c) {
             if (codes[c.texel] != DILATION_SELF) return true;
             curvedRefs += int64_t(c.triangles.size());
             if (curvedRefs * int64_t(sizeof(CurvedTriangle)) <= maxSsbo) return false;
-            ++flatInstead;  // past the binding's size: the flat texels' footprint along the owner's plane
+            // past the binding's size: a texel whose centre is on its chart is baked
+            // along its owner's plane, a partial one not at all (padding)
+            ++flatInstead;
+            if (partial[c.texel]) codes[c.texel] = DILATION_NONE;
             return true;
         });
+        stats.coveredTexels += std::count(codes.begin(), codes.end(), uint8_t(DILATION_SELF));
+        for (size_t i = 0; i < codes.size(); ++i) stats.partialTexels += partial[i] && codes[i] == DILATION_SELF;
+        chartNeighbourBits(codes, owners, charts, res, neighbours);
         for (size_t i = 0; i < owners.size(); ++i)
             ownerCharts[i] = uint16_t(owners[i] < 0 ? TEXEL_CHART_MASK : charts[size_t(owners[i])] & TEXEL_CHART_MASK);
         for (const CurvedTexel& c : curved[size_t(p)]) ownerCharts[c.texel] |= TEXEL_CURVED;
@@ -339,8 +396,9 @@ void Baker::Impl::coveragePass() {
     }
     uploadCurvedTexels(curved);
     if (flatInstead > 0)
-        logWarning(std::to_string(flatInstead) + " texels whose charts curve within them are baked as flat ones: the "
-                   "curved texels' records would pass GL_MAX_SHADER_STORAGE_BLOCK_SIZE (" + std::to_string(maxSsbo) +
+        logWarning(std::to_string(flatInstead) + " texels whose charts curve within them (or miss their centres) are "
+                   "baked as flat ones (or padding): the curved texels' records would pass "
+                   "GL_MAX_SHADER_STORAGE_BLOCK_SIZE (" + std::to_string(maxSsbo) +
                    " bytes); lower --resolution or --texel-density");
     stats.lightmapTexels = int64_t(res) * res * layout.pageCount;
     if (stats.sharedTexels * 100 > stats.coveredTexels)  // over 1 %: worth the user's look
@@ -362,6 +420,7 @@ void Baker::Impl::uploadCurvedTexels(const std::vector<std::vector<CurvedTexel>>
                                               curved.triangles.data(), 0);
     curvedClusterFirst = std::move(curved.clusterFirst);
     pointArray = gl::VertexArray::create("curved texels' points (no attributes)");
+    stats.curvedTexelBytes = curved.bytes();
     stats.lightmapStateBytes += curved.bytes();
 }
 
@@ -767,6 +826,10 @@ LightmapPages Baker::readLightmaps() {
         std::vector<uint8_t> cov(size_t(res) * res);
         gl::readTexture(m.dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, cov.data());
         for (uint8_t& c : cov) c = c == DILATION_SELF;
+        std::vector<glm::uvec3> footprints(cov.size());
+        gl::readTexture(m.footprint.id(), 0, 0, p, res, res, 1, GL_RGB_INTEGER, GL_UNSIGNED_INT, 12, footprints.data());
+        std::vector<uint8_t> area(cov.size());
+        for (size_t i = 0; i < area.size(); ++i) area[i] = uint8_t(footprints[i].z >> 24);
         for (int y0 = 0; y0 < res; y0 += rows) {
             const int n = std::min(rows, res - y0);
             m.resolveInto(band, y0, n, p, 1);
@@ -775,6 +838,7 @@ LightmapPages Baker::readLightmaps() {
         }
         out.pages.push_back(std::move(img));
         out.covered.push_back(std::move(cov));
+        out.area.push_back(std::move(area));
     }
     m.noteMemory();
     return out;

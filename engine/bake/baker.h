@@ -114,6 +114,9 @@ struct BakeStats {
     int64_t coveredTexels = 0;
     int64_t sharedTexels = 0;  // covered texels another chart also overlaps (layout/bake_mesh.h sharedTexels)
     int64_t curvedTexels = 0;  // covered texels whose chart folds or curves within them (layout/bake_mesh.h curvedTexels)
+                               // and partial texels (texelOwners), which are drawn as curved ones
+    int64_t partialTexels = 0;      // covered texels whose centre is on no chart (layout/bake_mesh.h texelOwners)
+    int64_t curvedTexelBytes = 0;   // their records (bake/curved_footprints.h), part of lightmapStateBytes
     std::vector<double> predictedOverActual;  // per tile: predicted nodes / actual nodes
     std::vector<int> tilesPerDirection;
     std::vector<int> leavesPerDirection;
@@ -169,6 +172,10 @@ struct LightmapPages {
     int resolution = 0;
     std::vector<io::ImageRgb> pages;
     std::vector<std::vector<uint8_t>> covered;
+    // per page and texel, the part of its square on its chart in 255ths
+    // (layout/bake_mesh.h texelFootprints: what the bake's samples cover);
+    // empty: whole squares (the reference's maps, maps read from files)
+    std::vector<std::vector<uint8_t>> area;
 };
 
 class Baker {

@@ -107,6 +107,12 @@ struct Baker::Impl {
         uint32_t count, page, material;
     };
     std::vector<SurfaceRun> surfaceRuns;  // metaIndexBuffer's (page, material) runs
+    // Partial texels (layout/bake_mesh.h texelOwners), which the raster misses:
+    // one point each, at the texel's centre with its owner's attributes at the
+    // owner's point nearest it, in (page, material) runs (first: in points).
+    gl::Buffer partialPointBuffer;
+    gl::VertexArray partialPointArray;
+    std::vector<SurfaceRun> partialRuns;
     int64_t nodeCapacity = 0;     // nodes the budget allows in one tile
     int subpixelBits = 8;         // GL_SUBPIXEL_BITS
     std::unique_ptr<BundleTracer> tracer;
@@ -125,9 +131,11 @@ struct Baker::Impl {
     Status buildPrograms();
     void uploadMesh();
     void uploadMaterials(const Scene& scene);
-    // Draws every page's triangles (meta.vert) into pageFbo in runs of one
-    // page and material, setting `page` and, if asked, the material's uniforms and textures.
+    // Draws every page's triangles and partial texels' points (meta.vert) into
+    // pageFbo in runs of one page and material, setting `page` and, if asked,
+    // the material's uniforms and textures.
     void drawSurface(GLuint program, bool materialUniforms);
+    void uploadPartialPoints();
     void coveragePass();
     void uploadCurvedTexels(const std::vector<std::vector<CurvedTexel>>& pages);
     void bakeSun();

@@ -65,10 +65,16 @@ struct BundleLimits {
     bool predict = true;       // size the buffers from the predictions (false: allocate the budget at once)
 };
 
+// Draws curved texels [first, first + count) (lib/curved_footprint.glsl) with
+// `program` (in use, their records bound, a res x res viewport): rectangles of
+// rows of res fragments from the viewport's corner, one fragment a texel
+// (lightmap/curved.vert).
+void drawCurvedTexelRun(GLuint program, int res, uint32_t first, uint32_t count);
+
 class BundleTracer {
 public:
     // The update's programs: over the tile's receiving clusters in light map
-    // space, and over their curved texels (setCurvedTexels; one point each).
+    // space, and over their curved texels (setCurvedTexels; a fragment each).
     // 0 skips that draw.
     struct UpdatePrograms {
         GLuint triangles = 0, curved = 0;
@@ -79,7 +85,7 @@ public:
 
     // Curved texels (bake/curved_footprints.h) for the updates: per cluster,
     // its first texel (clusterFirst; empty: none), and what binds their
-    // records for a draw of their points with the program given.
+    // records for a draw of them with the program given (drawCurvedTexelRun).
     void setCurvedTexels(std::vector<uint32_t> clusterFirst, std::function<void(GLuint)> bind);
 
     // Both passes read the triangle and vertex buffers as SSBOs in chunks of

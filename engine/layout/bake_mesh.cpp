@@ -126,10 +126,11 @@ double pageCorners(const BakeMesh& mesh, uint32_t t, int res, glm::dvec2 (&q)[3]
     return std::fabs(area2);
 }
 
-std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res) {
+std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res, std::vector<uint8_t>* partial) {
     CHECK(mesh.triangles.size() <= size_t(INT32_MAX));
     std::vector<int32_t> owner(size_t(res) * res, -1);
-    for (uint32_t t : pageDrawOrder(mesh, page)) {
+    const std::vector<uint32_t> order = pageDrawOrder(mesh, page);
+    for (uint32_t t : order) {
         glm::dvec2 q[3];
         const double absArea = pageCorners(mesh, t, res, q);
         if (absArea == 0.0 || !std::isfinite(absArea)) continue;
@@ -160,6 +161,36 @@ std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res) {
                 if (inside) owner[size_t(y) * res + x] = int32_t(t);
             }
     }
+    // texels no centre owns: the triangle holding the most of the square, where
+    // the triangles hold kMinPartialTexelArea of it in all
+    std::vector<double> best(owner.size(), 0.0), total(owner.size(), 0.0);
+    std::vector<uint8_t> isPartial(owner.size(), 0);
+    for (uint32_t t : order) {
+        glm::dvec2 q[3];
+        const double absArea = pageCorners(mesh, t, res, q);
+        if (absArea == 0.0 || !std::isfinite(absArea)) continue;
+        const TexelRange r = texelsUnder(q, res);
+        for (int y = r.y0; y <= r.y1; ++y)
+            for (int x = r.x0; x <= r.x1; ++x) {
+                const size_t i = size_t(y) * res + x;
+                if (owner[i] >= 0 && !isPartial[i]) continue;
+                const glm::dvec2 corner(x, y);
+                const glm::dvec2 local[3] = {q[0] - corner, q[1] - corner, q[2] - corner};
+                const double area = polygonArea(clipSquare(local));
+                if (!(area > 0.0)) continue;
+                total[i] += area;
+                if (!(area >= best[i])) continue;
+                best[i] = area;
+                owner[i] = int32_t(t);
+                isPartial[i] = 1;
+            }
+    }
+    for (size_t i = 0; i < owner.size(); ++i)
+        if (isPartial[i] && !(total[i] >= kMinPartialTexelArea)) {
+            owner[i] = -1;
+            isPartial[i] = 0;
+        }
+    if (partial) *partial = std::move(isPartial);
     return owner;
 }
 
@@ -384,7 +415,8 @@ bool texelAffine(const BakeMesh& mesh, uint32_t t, int res, bool normals, TexelA
 }
 
 std::vector<CurvedTexel> curvedTexels(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,
-                                      const std::vector<uint32_t>& chart, double departure) {
+                                      const std::vector<uint32_t>& chart, const std::vector<uint8_t>& partial,
+                                      double departure) {
     // every triangle of a covered texel's chart overlapping its square with
     // area, and how far it leaves the owner's plane there (at the corners of
     // its piece of the square), in the owner's texel sizes
@@ -425,8 +457,9 @@ std::vector<CurvedTexel> curvedTexels(const BakeMesh& mesh, int page, int res, c
         double worst = 0.0;
         for (end = begin; end < overlaps.size() && overlaps[end].texel == i; ++end)
             worst = std::max(worst, overlaps[end].departure);
-        if (!(worst > departure)) continue;
-        CurvedTexel texel{i, {o}};
+        const bool isPartial = !partial.empty() && partial[i];
+        if (!(worst > departure) && !isPartial) continue;
+        CurvedTexel texel{i, {o}, !(worst > departure)};
         for (size_t k = begin; k < end; ++k)
             if (overlaps[k].triangle != o) texel.triangles.push_back(overlaps[k].triangle);
         curved.push_back(std::move(texel));

@@ -73,7 +73,18 @@ double pageCorners(const BakeMesh& mesh, uint32_t t, int res, glm::dvec2 (&q)[3]
 // triangles overlap, the last in pageDrawOrder wins, as in the GPU's coverage
 // pass (llvmpipe snaps to 1/256 texel, so a centre exactly on an edge may
 // still differ).
-std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res);
+// A texel whose centre no triangle holds but whose square the triangles cover
+// in part (at least kMinPartialTexelArea of it: a chart border running past
+// the centre) is a texel too, as production bakers' conservative
+// rasterization makes it: its owner is the triangle holding the most of its
+// square (the last in pageDrawOrder of equals), and `partial` (if given) flags
+// it. The light map raster does not reach such texels; the light passes draw
+// them as curved ones (curvedTexels, CurvedTexel::flat). Thinner parts stay
+// padding: a bundle pixel's centre crosses them in too few directions
+// (update.frag footprintPixel), and a sliver a sixtieth of its square read
+// 20 % noise at 2048 directions where its neighbours read 1 %.
+constexpr double kMinPartialTexelArea = 0.25;
+std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res, std::vector<uint8_t>* partial = nullptr);
 
 // Which parts of each texel's square lie on its chart (the chart of its owner,
 // texelOwners): bit 8 j + i for the cell [i/8, (i+1)/8) x [j/8, (j+1)/8) of the
@@ -124,15 +135,21 @@ bool insideFootprintEdge(uint32_t code, glm::dvec2 offset);
 struct CurvedTexel {
     uint32_t texel = 0;               // y * res + x
     std::vector<uint32_t> triangles;  // the owner's chart's triangles overlapping its square with area, owner first
+    // A partial texel (texelOwners) whose chart is flat over its square: drawn
+    // as a point (the raster misses its centre) but sampled as flat texels
+    // are, along its owner's plane.
+    bool flat = false;
 };
 
 // The page's curved texels in texel order: of each covered texel, the part of
 // its square on its owner's chart (clipSquare) mapped through each of the
 // chart's triangles, against the same points on the owner's plane extended;
 // departures measured in the owner's texel size (the longer of its per-texel
-// steps along x and y).
+// steps along x and y). Every partial texel (`partial`, texelOwners' flags;
+// empty: none) is one, flat where it does not depart.
 std::vector<CurvedTexel> curvedTexels(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,
-                                      const std::vector<uint32_t>& chart, double departure = 0.02);
+                                      const std::vector<uint32_t>& chart, const std::vector<uint8_t>& partial = {},
+                                      double departure = 0.02);
 
 // Triangle t's position (normal) as an affine function of page texel
 // coordinates: at(q) = at0 + dx * (q.x - q0.x) + dy * (q.y - q0.y). False where

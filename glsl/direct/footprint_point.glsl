@@ -4,7 +4,7 @@
 // the triangles that hold them (lib/curved_footprint.glsl).
 // Needs lib/texel_footprint.glsl, `page` and `footprint`.
 #ifdef CURVED_FOOTPRINT
-flat in uint vCurved;
+uint vCurved;  // this fragment's curved texel (curvedFragmentIndex)
 #include "lib/curved_footprint.glsl"
 #else
 in vec3 vPosition;
@@ -31,8 +31,9 @@ struct FootprintPoint {
 
 #ifdef CURVED_FOOTPRINT
 bool texelFootprint(out TexelFootprint t) {
+    if (gl_HelperInvocation || !curvedFragmentIndex(vCurved)) return false;
     uvec4 head = curvedTexels[vCurved];
-    t.texel = ivec3(ivec2(gl_FragCoord.xy), int(head.y));
+    t.texel = curvedTexelTexel(head);
     t.footprint = texelFetch(footprint, t.texel, 0).rgb;
     t.centre = curvedTexelCentre(vCurved);
     CurvedTriangle owner = curvedTriangles[curvedRefs[head.z]];
@@ -41,6 +42,14 @@ bool texelFootprint(out TexelFootprint t) {
 }
 
 FootprintPoint footprintPoint(TexelFootprint t, uint sampleIndex) {
+    if (curvedTexelIsFlat(curvedTexels[vCurved])) {
+        // a flat partial texel: along its owner's plane, as the raster's texels
+        FlatFrame f = curvedFlatFrame(vCurved);
+        vec2 o = footprintOffset(f.bary, f.baryDx, f.baryDy, f.flags, t.footprint, sampleIndex);
+        return FootprintPoint(f.position + f.positionDx * o.x + f.positionDy * o.y,
+                              normalize(f.normal + f.normalDx * o.x + f.normalDy * o.y),
+                              cross(f.positionDx, f.positionDy));
+    }
     vec2 point;
     CurvedTriangle tri;
     curvedFootprintPoint(vCurved, t.footprint.xy, sampleIndex, point, tri);

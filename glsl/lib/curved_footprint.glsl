@@ -11,8 +11,14 @@
 //
 // Needs shared/bundle_layout.h, lib/rounding.glsl and lib/texel_footprint.glsl.
 
-// A curved texel: uvec4(x | y << 16, page, first ref, ref count).
+// A curved texel: uvec4(x | y << 16, page, first ref, ref count | CURVED_TEXEL_FLAT).
 layout(std430, binding = BINDING_CURVED_TEXELS) readonly buffer CurvedTexels { uvec4 curvedTexels[]; };
+
+// A partial texel (engine/layout/bake_mesh.h texelOwners: its centre on no
+// triangle, its square partly on a chart) that is flat: sampled as the
+// raster's texels are, along its owner's plane (curvedFlatTexel).
+bool curvedTexelIsFlat(uvec4 head) { return (head.w & CURVED_TEXEL_FLAT) != 0u; }
+uint curvedTexelTriangles(uvec4 head) { return head.w & ~CURVED_TEXEL_FLAT; }
 // Per curved texel, its triangles (indices into curvedTriangles), owner first.
 layout(std430, binding = BINDING_CURVED_REFS) readonly buffer CurvedRefs { uint curvedRefs[]; };
 // engine/bake/curved_footprints.h CurvedTriangle: the triangle in page texels
@@ -40,34 +46,105 @@ bool curvedTriangleHolds(CurvedTriangle c, vec2 p) {
     return all(greaterThanEqual(w * sign(area), vec3(0.0)));
 }
 
+// A curved draw (lightmap/curved.vert) covers curved texels [curvedFirst,
+// curvedFirst + curvedCount) with one rectangle, curvedRowWidth texels a row
+// from the viewport's corner: llvmpipe shades 4 x 4 blocks, and a point a
+// texel cost a block each (the update pass +80 % on a city whose chart
+// borders' partial texels were drawn so).
+uniform uint curvedFirst;
+uniform uint curvedCount;
+uniform uint curvedRowWidth;
+
+#ifndef CURVED_VERTEX_SHADER
+// This fragment's curved texel (its index); false past the draw's run.
+bool curvedFragmentIndex(out uint index) {
+    uvec2 p = uvec2(gl_FragCoord.xy);
+    uint k = p.y * curvedRowWidth + p.x;
+    index = curvedFirst + k;
+    return k < curvedCount;
+}
+#endif
+
+// A curved texel's texel in its page (`head`: its first uvec4).
+ivec3 curvedTexelTexel(uvec4 head) { return ivec3(int(head.x & 0xffffu), int(head.x >> 16u), int(head.y)); }
+
 // A curved texel's square's centre in page texels (`head`: its first uvec4).
 vec2 curvedTexelSquareCentre(uvec4 head) { return vec2(head.x & 0xffffu, head.x >> 16u) + 0.5; }
 
+// The point of segment [a, b] nearest p.
+vec2 nearestOnSegment(vec2 a, vec2 b, vec2 p) {
+    vec2 e = b - a;
+    return a + e * clamp(dot(p - a, e) / max(dot(e, e), 1e-30), 0.0, 1.0);
+}
+
+// The point of triangle c nearest page point p (p where c holds it).
+vec2 nearestOnTriangle(CurvedTriangle c, vec2 p) {
+    if (curvedTriangleHolds(c, p)) return p;
+    vec2 a = c.corners01.xy, b = c.corners01.zw, d = c.corner2.xy;
+    vec2 best = nearestOnSegment(a, b, p);
+    vec2 other = nearestOnSegment(b, d, p);
+    if (distance(other, p) < distance(best, p)) best = other;
+    other = nearestOnSegment(d, a, p);
+    return distance(other, p) < distance(best, p) ? other : best;
+}
+
+// Triangle c's position at page point p (its plane, extended past it).
+vec3 curvedTrianglePosition(CurvedTriangle c, vec2 p) {
+    vec2 q = p - c.corners01.xy;
+    return c.position.xyz + c.positionDx.xyz * q.x + c.positionDy.xyz * q.y;
+}
+
 // Curved texel `index`'s centre on its owner triangle (the first of its
-// triangles, which holds the centre): where the leaf that takes its samples is.
+// triangles, which holds the centre, or of a partial texel the point nearest
+// it): where the leaf that takes its samples is.
 vec3 curvedTexelCentre(uint index) {
     uvec4 head = curvedTexels[index];
     CurvedTriangle owner = curvedTriangles[curvedRefs[head.z]];
-    vec2 q = curvedTexelSquareCentre(head) - owner.corners01.xy;
-    return owner.position.xyz + owner.positionDx.xyz * q.x + owner.positionDy.xyz * q.y;
+    return curvedTrianglePosition(owner, nearestOnTriangle(owner, curvedTexelSquareCentre(head)));
+}
+
+// A flat partial texel's frame (curvedTexelIsFlat, lib/texel_footprint.glsl
+// FlatFrame): its owner's at the square's centre, on the owner's plane extended.
+FlatFrame curvedFlatFrame(uint index) {
+    uvec4 head = curvedTexels[index];
+    CurvedTriangle c = curvedTriangles[curvedRefs[head.z]];
+    vec2 a = c.corners01.xy, e1 = c.corners01.zw - a, e2 = c.corner2.xy - a;
+    vec2 q = curvedTexelSquareCentre(head) - a;
+    float det = e1.x * e2.y - e1.y * e2.x;
+    // barycentrics 1 and 2 solve e1 b1 + e2 b2 = q; their steps per texel are the inverse's rows
+    vec2 dB1 = vec2(e2.y, -e2.x) / det, dB2 = vec2(-e1.y, e1.x) / det;
+    float b1 = dot(dB1, q), b2 = dot(dB2, q);
+    FlatFrame f;
+    f.position = c.position.xyz + c.positionDx.xyz * q.x + c.positionDy.xyz * q.y;
+    f.normal = c.normal.xyz + c.normalDx.xyz * q.x + c.normalDy.xyz * q.y;
+    f.bary = vec3(1.0 - b1 - b2, b1, b2);
+    f.baryDx = vec3(-dB1.x - dB2.x, dB1.x, dB2.x);
+    f.baryDy = vec3(-dB1.y - dB2.y, dB1.y, dB2.y);
+    f.positionDx = c.positionDx.xyz;
+    f.positionDy = c.positionDy.xyz;
+    f.normalDx = c.normalDx.xyz;
+    f.normalDy = c.normalDy.xyz;
+    f.flags = floatBitsToUint(c.corner2.z);
+    return f;
 }
 
 // Sample `sampleIndex`'s point of curved texel `index` (its square's part on
 // the chart, uniform: candidates as footprintOffset draws them, each kept if
 // one of the texel's triangles holds it): page point `point`, triangle `tri`.
-// After 8 candidates the centre, which the owner holds.
+// After 8 candidates the owner's point nearest the centre.
 void curvedFootprintPoint(uint index, uvec2 cells, uint sampleIndex, out vec2 point, out CurvedTriangle tri) {
     uvec4 head = curvedTexels[index];
     vec2 centre = curvedTexelSquareCentre(head);
+    uint count = curvedTexelTriangles(head);
     for (int attempt = 0; attempt < 8; ++attempt) {
-        vec2 offset = footprintCandidate(sampleIndex, attempt);
+        vec2 offset = footprintCandidate(sampleIndex, attempt, cells);
         if (!cellOnChart(cells, offset)) continue;
         point = centre + offset;
-        for (uint k = 0u; k < head.w; ++k) {
+        for (uint k = 0u; k < count; ++k) {
             tri = curvedTriangles[curvedRefs[head.z + k]];
             if (curvedTriangleHolds(tri, point)) return;
         }
     }
-    point = centre;
     tri = curvedTriangles[curvedRefs[head.z]];
+    point = nearestOnTriangle(tri, centre);
 }

@@ -18,6 +18,17 @@
 //
 // Needs lib/rounding.glsl (pcgHash, uniform01) and shared/mesh_layout.h.
 
+// A texel's frame along its triangle's plane, at its centre: what the light
+// map raster gives a fragment (its varyings and their screen derivatives, one
+// texel a step), or a flat partial texel's point (lib/curved_footprint.glsl
+// curvedFlatFrame): position, shading normal, barycentrics (vertex order),
+// their steps per texel along x and y, and the triangle's flags.
+struct FlatFrame {
+    vec3 position, normal, bary;
+    vec3 positionDx, positionDy, normalDx, normalDy, baryDx, baryDy;
+    uint flags;
+};
+
 // Whether the eighth-texel cell of `offset` (texels from the centre) touches
 // the chart (`cells`, as offChart's).
 bool cellOnChart(uvec2 cells, vec2 offset) {
@@ -61,21 +72,38 @@ bool offChart(vec3 bary, vec3 baryDx, vec3 baryDy, uint flags, uvec3 footprint, 
 
 // Candidate `attempt` of sample `sampleIndex`'s point, in texels from the
 // centre, each coordinate in [-0.5, 0.5): attempt 0 is point sampleIndex of
-// R2, the others hashed (uniform).
-vec2 footprintCandidate(uint sampleIndex, int attempt) {
+// R2, the others hashed, uniform over the cells that touch the chart
+// (`cells`, cellOnChart's; all of the square if none): a texel a tenth on its
+// chart (a ledge's, a partial texel's) finds its part in a few attempts, not
+// in one of ten.
+vec2 footprintCandidate(uint sampleIndex, int attempt, uvec2 cells) {
     if (attempt == 0) {
         // R2 in 32-bit fixed point (alpha * 2^32, wrapping: exact for any index), from 0.5
         uvec2 fixedPoint = uvec2(sampleIndex * 3242174889u, sampleIndex * 2447445413u) + 0x80000000u;
         return vec2(fixedPoint >> 8u) * (1.0 / 16777216.0) - 0.5;
     }
-    uint h = pcgHash(sampleIndex * 8u + uint(attempt - 1));
-    return vec2(uniform01(h), uniform01(pcgHash(h))) - 0.5;
+    uint h = pcgHash(sampleIndex * 8u + uint(attempt - 1)), h1 = pcgHash(h), h2 = pcgHash(h1);
+    uint low = uint(bitCount(cells.x)), count = low + uint(bitCount(cells.y));
+    if (count == 0u) return vec2(uniform01(h), uniform01(h1)) - 0.5;
+    // the k-th cell on the chart, k uniform
+    uint k = min(uint(uniform01(h2) * float(count)), count - 1u);
+    uint word = k < low ? cells.x : cells.y, cell = k < low ? 0u : 32u;
+    k = k < low ? k : k - low;
+    for (uint i = 0u; i < 32u; ++i) {
+        if ((word & (1u << i)) == 0u) continue;
+        if (k == 0u) {
+            cell += i;
+            break;
+        }
+        --k;
+    }
+    return (vec2(cell % 8u, cell / 8u) + vec2(uniform01(h), uniform01(h1))) * 0.125 - 0.5;
 }
 
 // Offset in texels of sample `sampleIndex`'s point, each coordinate in [-0.5, 0.5).
 vec2 footprintOffset(vec3 bary, vec3 baryDx, vec3 baryDy, uint flags, uvec3 footprint, uint sampleIndex) {
     for (int attempt = 0; attempt < 8; ++attempt) {
-        vec2 offset = footprintCandidate(sampleIndex, attempt);
+        vec2 offset = footprintCandidate(sampleIndex, attempt, footprint.xy);
         if (!offChart(bary, baryDx, baryDy, flags, footprint, offset)) return offset;
     }
     return vec2(0.0);

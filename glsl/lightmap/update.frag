@@ -32,8 +32,8 @@
 #include "lib/texel_footprint.glsl"
 
 #ifdef CURVED_FOOTPRINT
-// a curved texel (lib/curved_footprint.glsl; lightmap/curved.vert draws one point each)
-flat in uint vCurved;
+// a curved texel (lib/curved_footprint.glsl curvedFragmentIndex: lightmap/curved.vert draws a fragment each)
+uint vCurved;
 #else
 in vec3 vPosition;
 in vec3 vNormal;
@@ -272,55 +272,21 @@ struct TexelSample {
     float weight;
 };
 
-#ifdef CURVED_FOOTPRINT
-// A curved texel's sample: its point on the triangle that holds it
-// (curvedFootprintPoint), read along the ray of the pixel it lies in: the
-// pixel-centre crossings of footprintPixel assume one plane over the square.
-// False: another leaf's.
-bool curvedSample(out TexelSample s) {
-    s.texel = ivec3(ivec2(gl_FragCoord.xy), int(curvedTexels[vCurved].y));
-    // the leaf of the texel's centre takes its sample, as on flat texels
-    if (!leafOwns(rootFromBundle(bundleFromWorld(curvedTexelCentre(vCurved)).xy))) return false;
-    vec2 point;
-    CurvedTriangle tri;
-    curvedFootprintPoint(vCurved, texelFetch(footprint, s.texel, 0).xy, footprintSample, point, tri);
-    vec2 q = point - tri.corners01.xy;
-    s.position = tri.position.xyz + tri.positionDx.xyz * q.x + tri.positionDy.xyz * q.y;
-    s.anchor = s.position;
-    s.n = normalize(tri.normal.xyz + tri.normalDx.xyz * q.x + tri.normalDy.xyz * q.y);
-    s.ng = tri.faceNormal.xyz;
-    s.texelSize = max(length(tri.positionDx.xyz), length(tri.positionDy.xyz));
-    s.curvature = tri.corner2.w;
-    s.flags = floatBitsToUint(tri.corner2.z);
-    s.weight = 1.0;
-    return true;
-}
-#else
-// A light map fragment's sample: a point of the texel's footprint along the
-// triangle's own plane (lib/texel_footprint.glsl), at a pixel centre's
-// crossing where one is found (footprintPixel). False: no sample (a helper
-// lane, a curved texel, another leaf's, a grazing direction with no crossing).
-bool triangleSample(out TexelSample s) {
-    // the triangle's own plane, from screen derivatives (before any return:
-    // derivatives need the whole quad)
-    vec3 positionDx = dFdx(vPosition), positionDy = dFdy(vPosition);
-    vec3 normalDx = dFdx(vNormal), normalDy = dFdy(vNormal);
-    vec3 baryDx = dFdx(vBary), baryDy = dFdy(vBary);
-    vec3 faceNormal = cross(positionDx, positionDy);
+// One sample of a texel along its triangle's plane (frame f at the texel's
+// centre: a light map fragment's, or a flat partial texel's; `leafPoint`: a
+// point of the texel on its triangle, whose leaf takes the sample): a point of
+// the texel's footprint (lib/texel_footprint.glsl), at a pixel centre's
+// crossing where one is found (footprintPixel). False: no sample (another
+// leaf's, a grazing direction with no crossing).
+bool planeSample(FlatFrame f, ivec3 texel, vec3 leafPoint, out TexelSample s) {
+    vec3 faceNormal = cross(f.positionDx, f.positionDy);
     // this texel's size on the surface (one step of the light map raster)
-    s.texelSize = max(length(positionDx), length(positionDy));
-    // llvmpipe runs helper lanes through the walk with undefined loads, where they
-    // spin; they have no side effects to make, so leave at once (GLSL 4.50).
-    if (gl_HelperInvocation) return false;
-    // this sample's point of the texel's footprint (lib/texel_footprint.glsl):
-    // a texel half under a building reads half its outside value, as the
-    // reference's does (the city under a sky: 6.6 % -> 5.3 % against it)
-    s.texel = ivec3(ivec2(gl_FragCoord.xy), int(vPage));
-    if ((texelFetch(texelCharts, s.texel, 0).r & TEXEL_CURVED) != 0u) return false;
+    s.texelSize = max(length(f.positionDx), length(f.positionDy));
+    s.texel = texel;
     // the leaf of the texel's centre takes its sample (a sample whose point
     // lies in another leaf is lost, at random: leaves move with d)
-    vec2 centreRoot = rootFromBundle(bundleFromWorld(vPosition).xy);
-    if (!leafOwns(centreRoot)) return false;
+    if (!leafOwns(rootFromBundle(bundleFromWorld(leafPoint).xy))) return false;
+    vec2 centreRoot = rootFromBundle(bundleFromWorld(f.position).xy);
 #ifdef SUN_PASS
     uint pixelSeed = pcgHash(footprintSample + 0x632be5abu);
 #else
@@ -328,12 +294,12 @@ bool triangleSample(out TexelSample s) {
 #endif
     vec2 jitter;
     uvec3 onChart = texelFetch(footprint, s.texel, 0).rgb;
-    if (!footprintPixel(gridFromRoot(centreRoot), positionDx, positionDy, vBary, baryDx, baryDy, vFlags, onChart,
-                        pixelSeed, jitter, s.weight)) {
+    if (!footprintPixel(gridFromRoot(centreRoot), f.positionDx, f.positionDy, f.bary, f.baryDx, f.baryDy, f.flags,
+                        onChart, pixelSeed, jitter, s.weight)) {
 #ifndef SUN_PASS
         if (s.weight == 0.0) return false;  // a grazing direction no pixel centre crossed the footprint in
 #endif
-        jitter = footprintOffset(vBary, baryDx, baryDy, vFlags, onChart, footprintSample);
+        jitter = footprintOffset(f.bary, f.baryDx, f.baryDy, f.flags, onChart, footprintSample);
 #ifdef SUN_PASS
         // The sun's sample is where its pixel's ray meets the surface: the pixel
         // (jittered from run to run, bakeSun) spreads it too, by up to half a
@@ -345,26 +311,83 @@ bool triangleSample(out TexelSample s) {
         jitter *= clamp(1.0 - pixelSize / (max(facing, 1e-3) * max(s.texelSize, 1e-30)), 0.0, 1.0);
 #endif
     }
-    s.position = vPosition + positionDx * jitter.x + positionDy * jitter.y;
-    s.anchor = vPosition;
+    s.position = f.position + f.positionDx * jitter.x + f.positionDy * jitter.y;
+    s.anchor = leafPoint;
     // the shading normal where the point leaves the triangle, not extrapolated
     // past it: a triangle far smaller than a texel (300 to a texel on the
     // chair of mixed_lighting) would swing it by tens of degrees
-    vec3 baryStep = baryDx * jitter.x + baryDy * jitter.y;
+    vec3 baryStep = f.baryDx * jitter.x + f.baryDy * jitter.y;
     float inside = 1.0;
     for (int k = 0; k < 3; ++k)
-        if (baryStep[k] < 0.0) inside = min(inside, max(vBary[k], 0.0) / -baryStep[k]);
-    s.n = normalize(vNormal + (normalDx * jitter.x + normalDy * jitter.y) * inside);
+        if (baryStep[k] < 0.0) inside = min(inside, max(f.bary[k], 0.0) / -baryStep[k]);
+    s.n = normalize(f.normal + (f.normalDx * jitter.x + f.normalDy * jitter.y) * inside);
     // the triangle's plane, on the side the bundle pass gives its fragments
     // (lib/triangle_side.glsl; the flag is computed with the mesh)
     s.ng = s.n;
     if (length(faceNormal) > 0.0) {
         s.ng = normalize(faceNormal);
-        if ((vFlags & TRIANGLE_DERIVATIVE_NORMAL_FLIPPED) != 0u) s.ng = -s.ng;
+        if ((f.flags & TRIANGLE_DERIVATIVE_NORMAL_FLIPPED) != 0u) s.ng = -s.ng;
     }
-    s.curvature = max(length(normalDx) / max(length(positionDx), 1e-30), length(normalDy) / max(length(positionDy), 1e-30));
-    s.flags = vFlags;
+    s.curvature = max(length(f.normalDx) / max(length(f.positionDx), 1e-30),
+                      length(f.normalDy) / max(length(f.positionDy), 1e-30));
+    s.flags = f.flags;
     return true;
+}
+
+#ifdef CURVED_FOOTPRINT
+// A curved texel's sample: its point on the triangle that holds it
+// (curvedFootprintPoint), read along the ray of the pixel it lies in: the
+// pixel-centre crossings of footprintPixel assume one plane over the square.
+// A flat partial texel's (curvedTexelIsFlat): planeSample's, from its frame.
+// False: another leaf's.
+bool curvedSample(out TexelSample s) {
+    if (gl_HelperInvocation || !curvedFragmentIndex(vCurved)) return false;
+    uvec4 head = curvedTexels[vCurved];
+    ivec3 texel = curvedTexelTexel(head);
+    if (curvedTexelIsFlat(head)) return planeSample(curvedFlatFrame(vCurved), texel, curvedTexelCentre(vCurved), s);
+    s.texel = texel;
+    // the leaf of the texel's centre takes its sample, as on flat texels
+    if (!leafOwns(rootFromBundle(bundleFromWorld(curvedTexelCentre(vCurved)).xy))) return false;
+    vec2 point;
+    CurvedTriangle tri;
+    curvedFootprintPoint(vCurved, texelFetch(footprint, s.texel, 0).xy, footprintSample, point, tri);
+    s.position = curvedTrianglePosition(tri, point);
+    s.anchor = s.position;
+    vec2 q = point - tri.corners01.xy;
+    s.n = normalize(tri.normal.xyz + tri.normalDx.xyz * q.x + tri.normalDy.xyz * q.y);
+    s.ng = tri.faceNormal.xyz;
+    s.texelSize = max(length(tri.positionDx.xyz), length(tri.positionDy.xyz));
+    s.curvature = tri.corner2.w;
+    s.flags = floatBitsToUint(tri.corner2.z);
+    s.weight = 1.0;
+    return true;
+}
+#else
+// A light map fragment's sample (planeSample). False: no sample (a helper
+// lane, a curved texel, another leaf's, a grazing direction with no crossing).
+bool triangleSample(out TexelSample s) {
+    // the triangle's own plane, from screen derivatives (before any return:
+    // derivatives need the whole quad)
+    FlatFrame f;
+    f.position = vPosition;
+    f.normal = vNormal;
+    f.bary = vBary;
+    f.positionDx = dFdx(vPosition);
+    f.positionDy = dFdy(vPosition);
+    f.normalDx = dFdx(vNormal);
+    f.normalDy = dFdy(vNormal);
+    f.baryDx = dFdx(vBary);
+    f.baryDy = dFdy(vBary);
+    f.flags = vFlags;
+    // llvmpipe runs helper lanes through the walk with undefined loads, where they
+    // spin; they have no side effects to make, so leave at once (GLSL 4.50).
+    if (gl_HelperInvocation) return false;
+    // this sample's point of the texel's footprint (lib/texel_footprint.glsl):
+    // a texel half under a building reads half its outside value, as the
+    // reference's does (the city under a sky: 6.6 % -> 5.3 % against it)
+    ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), int(vPage));
+    if ((texelFetch(texelCharts, texel, 0).r & TEXEL_CURVED) != 0u) return false;
+    return planeSample(f, texel, vPosition, s);
 }
 #endif
 
@@ -372,8 +395,10 @@ void main() {
     TexelSample s;
 #ifdef CURVED_FOOTPRINT
     if (!curvedSample(s)) return;
+    bool curved = !curvedTexelIsFlat(curvedTexels[vCurved]);  // not a flat partial texel
 #else
     if (!triangleSample(s)) return;
+    const bool curved = false;
 #endif
     ivec3 texel = s.texel;
     vec3 b = bundleFromWorld(s.position);
@@ -395,9 +420,7 @@ void main() {
     // 0: no light); a curved texel's point facing away is one of its samples,
     // dark, once its ray is found below like the lit ones'.
     bool lit = !ahead && cosine > 0.0;
-#ifndef CURVED_FOOTPRINT
-    if (!lit) return;
-#endif
+    if (!lit && !curved) return;
 #else
     if (cosine <= 0.0) return;
 #endif
@@ -430,7 +453,7 @@ void main() {
             self = ownCrossing(own, neighbour, offset - vec2(step) * pixelSize);
             if (self != NO_CROSSING) pixel = neighbour;
         }
-#if defined(CURVED_FOOTPRINT) && defined(SUN_PASS)
+#ifdef SUN_PASS
         // A curved texel's sun sample counts whatever its light: skipped, the
         // facets the sun grazes (those between a tube's lit and dark halves)
         // went missing from the mean, and a tube read 5 % bright. It reads
@@ -439,10 +462,9 @@ void main() {
         // update pass's samples weigh by their cosine, and are skipped: a
         // ray beside the point from its own depth starts inside a convex
         // surface and sees its back (a sphere in the furnace 1.3 % dark).
-        if (self == NO_CROSSING) self = b.z;
-#else
-        if (self == NO_CROSSING) return;
+        if (self == NO_CROSSING && curved) self = b.z;
 #endif
+        if (self == NO_CROSSING) return;
     }
     float start = self + (ahead ? depthBias : -depthBias);
 

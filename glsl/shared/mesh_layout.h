@@ -25,9 +25,14 @@
 // (TEXEL_CHART_MASK; uncovered: all of them set), and TEXEL_CURVED where its
 // chart folds or curves within its square (engine/layout/bake_mesh.h
 // curvedTexels): the update pass's light map raster leaves such texels to
-// the curved texels' draw (lib/curved_footprint.glsl).
+// the curved texels' draw (lib/curved_footprint.glsl), as it does partial
+// texels, whose centre no triangle holds (texelOwners).
 #define TEXEL_CHART_MASK 0x7fffu
 #define TEXEL_CURVED 0x8000u
+// A curved texel's record (lib/curved_footprint.glsl): in its triangle count's
+// top bit, a partial texel whose chart is flat over its square (CurvedTexel::flat):
+// sampled along its owner's plane, as the raster's texels are.
+#define CURVED_TEXEL_FLAT 0x80000000u
 
 // SSBO binding of BakeTriangle triangles[] (lib/bake_vertex.glsl), bound in
 // chunks by MeshChunks (engine/layout/bake_mesh_gl.h)
