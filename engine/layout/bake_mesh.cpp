@@ -69,6 +69,22 @@ TexelRange texelsUnder(const glm::dvec2 (&q)[3], int res) {
             std::min(res - 1, int(std::floor(std::max({q[0].y, q[1].y, q[2].y}))))};
 }
 
+// Calls f(x, y, i) for every texel (i = y * res + x) whose square the bounds
+// of page-space triangle q touch.
+template <class F>
+void forTexelsUnder(const glm::dvec2 (&q)[3], int res, F&& f) {
+    const TexelRange r = texelsUnder(q, res);
+    for (int y = r.y0; y <= r.y1; ++y)
+        for (int x = r.x0; x <= r.x1; ++x) f(x, y, size_t(y) * res + x);
+}
+
+// The part of texel (x, y)'s square on page-space triangle q, in the texel's coordinates.
+std::vector<glm::dvec2> squareOnTriangle(const glm::dvec2 (&q)[3], int x, int y) {
+    const glm::dvec2 corner(x, y);
+    const glm::dvec2 local[3] = {q[0] - corner, q[1] - corner, q[2] - corner};
+    return clipSquare(local);
+}
+
 // Twice the signed area of a polygon (counter-clockwise positive), then halved.
 double polygonArea(const std::vector<glm::dvec2>& poly) {
     double area2 = 0.0;
@@ -169,21 +185,16 @@ std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res, std::v
         glm::dvec2 q[3];
         const double absArea = pageCorners(mesh, t, res, q);
         if (absArea == 0.0 || !std::isfinite(absArea)) continue;
-        const TexelRange r = texelsUnder(q, res);
-        for (int y = r.y0; y <= r.y1; ++y)
-            for (int x = r.x0; x <= r.x1; ++x) {
-                const size_t i = size_t(y) * res + x;
-                if (owner[i] >= 0 && !isPartial[i]) continue;
-                const glm::dvec2 corner(x, y);
-                const glm::dvec2 local[3] = {q[0] - corner, q[1] - corner, q[2] - corner};
-                const double area = polygonArea(clipSquare(local));
-                if (!(area > 0.0)) continue;
-                total[i] += area;
-                if (!(area >= best[i])) continue;
-                best[i] = area;
-                owner[i] = int32_t(t);
-                isPartial[i] = 1;
-            }
+        forTexelsUnder(q, res, [&](int x, int y, size_t i) {
+            if (owner[i] >= 0 && !isPartial[i]) return;
+            const double area = polygonArea(squareOnTriangle(q, x, y));
+            if (!(area > 0.0)) return;
+            total[i] += area;
+            if (!(area >= best[i])) return;
+            best[i] = area;
+            owner[i] = int32_t(t);
+            isPartial[i] = 1;
+        });
     }
     for (size_t i = 0; i < owner.size(); ++i)
         if (isPartial[i] && !(total[i] >= kMinPartialTexelArea)) {
@@ -275,13 +286,10 @@ std::vector<TexelFootprint> texelFootprints(const BakeMesh& mesh, int page, int 
         glm::dvec2 q[3];
         const double absArea = pageCorners(mesh, t, res, q);
         if (absArea == 0.0 || !std::isfinite(absArea)) continue;
-        const TexelRange r = texelsUnder(q, res);
-        for (int y = r.y0; y <= r.y1; ++y)
-            for (int x = r.x0; x <= r.x1; ++x) {
-                const size_t i = size_t(y) * res + x;
-                if (owner[i] >= 0 && mask[i] != ~uint64_t(0) && chart[size_t(owner[i])] == chart[t])
-                    overlaps.push_back({uint32_t(i), t});
-            }
+        forTexelsUnder(q, res, [&](int, int, size_t i) {
+            if (owner[i] >= 0 && mask[i] != ~uint64_t(0) && chart[size_t(owner[i])] == chart[t])
+                overlaps.push_back({uint32_t(i), t});
+        });
     }
     std::sort(overlaps.begin(), overlaps.end());
     // a triangle's corners in vertex order (its border bits' order), from a texel's centre
@@ -476,16 +484,13 @@ size_t sharedTexels(const BakeMesh& mesh, int page, int res, const std::vector<i
         const double absArea = pageCorners(mesh, t, res, q);
         if (absArea == 0.0 || !std::isfinite(absArea)) continue;
         // overlapping with area: the square clipped to the triangle keeps some
-        auto overlaps = [&](int x, int y) {
-            const glm::dvec2 o(x, y);
-            const glm::dvec2 local[3] = {q[0] - o, q[1] - o, q[2] - o};
-            return polygonArea(clipSquare(local)) > 0.0;
-        };
         const TexelRange r = texelsUnder(q, res);
         for (int y = r.y0; y <= r.y1; ++y)
             for (int x = r.x0; x <= r.x1; ++x) {
                 const size_t i = size_t(y) * res + x;
-                if (shared[i] || owner[i] < 0 || chart[size_t(owner[i])] == chart[t] || !overlaps(x, y)) continue;
+                if (shared[i] || owner[i] < 0 || chart[size_t(owner[i])] == chart[t] ||
+                    !(polygonArea(squareOnTriangle(q, x, y)) > 0.0))
+                    continue;
                 shared[i] = 1;
                 ++count;
             }
