@@ -345,6 +345,8 @@ void Baker::Impl::coveragePass() {
     glClearTexImage(dilation.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_BYTE, &none);
     glBindImageTexture(BINDING_DILATION, dilation.id(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R8UI);
     bindAlphaMasks();  // a cut-away texel centre is not covered
+    // the partial texels' points (texelOwners, page by page; the loop below takes
+    // each page's owners again rather than holding every page's at once)
     uploadPartialPoints();
     drawSurface(coverageProgram.id(), false);
     // padding: the nearest covered texel, page by page on the CPU (once)
@@ -419,7 +421,7 @@ void Baker::Impl::uploadCurvedTexels(const std::vector<std::vector<CurvedTexel>>
     curvedTriangleBuffer = gl::Buffer::create("curved triangles", int64_t(curved.triangles.size() * sizeof(CurvedTriangle)),
                                               curved.triangles.data(), 0);
     curvedClusterFirst = std::move(curved.clusterFirst);
-    pointArray = gl::VertexArray::create("curved texels' points (no attributes)");
+    pointArray = gl::VertexArray::create("curved texels' rectangles (no attributes)");
     stats.curvedTexelBytes = curved.bytes();
     stats.lightmapStateBytes += curved.bytes();
 }

@@ -94,10 +94,10 @@ struct Baker::Impl {
     // curved texels (bake/curved_footprints.h): their records, and per cluster its first one
     gl::Buffer curvedTexelBuffer, curvedRefBuffer, curvedTriangleBuffer;
     std::vector<uint32_t> curvedClusterFirst;  // empty: none
-    gl::VertexArray pointArray;                // no attributes: the points read the curved texels' SSBO
+    gl::VertexArray pointArray;                // no attributes: the rectangles read the curved texels' SSBO
     size_t curvedTexelCount() const { return curvedClusterFirst.empty() ? 0 : curvedClusterFirst.back(); }
     // Binds the curved texels' SSBOs, `program`'s pageResolution (bound) and
-    // the point vertex array, for a draw of their points (lightmap/curved.vert).
+    // the empty vertex array, for a draw of them (lightmap/curved.vert).
     void bindCurvedTexels(GLuint program) const;
     gl::Buffer materialAlphaBuffer, alphaTexelBuffer;  // cut-outs (glsl/shared/material_layout.h; cutouts.cpp)
     std::vector<glm::vec3> textureMeans;  // mean linear RGB of each scene texture (explicit emitters)

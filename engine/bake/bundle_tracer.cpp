@@ -98,21 +98,21 @@ void BundleTracer::drawCurvedTexels(GLuint program, const std::vector<uint32_t>&
                         int32_t(curvedClusterFirst_[c + 1] - curvedClusterFirst_[c]));
     if (drawFirst_.empty()) return;
     bindCurvedTexels_(program);
-    for (size_t k = 0; k < drawFirst_.size(); ++k)
-        drawCurvedTexelRun(program, scene_.pageResolution, uint32_t(drawFirst_[k]), uint32_t(drawCount_[k]));
+    drawCurvedTexelRuns(program, scene_.pageResolution, drawFirst_, drawCount_);
     glBindVertexArray(scene_.vertexArray);
 }
 
-void drawCurvedTexelRun(GLuint program, int res, uint32_t first, uint32_t count) {
+void drawCurvedTexelRuns(GLuint program, int res, const std::vector<int32_t>& first, const std::vector<int32_t>& count) {
     const GLint firstUniform = glGetUniformLocation(program, "curvedFirst");
     const GLint countUniform = glGetUniformLocation(program, "curvedCount");
     glUniform1ui(glGetUniformLocation(program, "curvedRowWidth"), uint32_t(res));
     const uint32_t most = uint32_t(res) * uint32_t(res);  // what one viewport holds
-    for (uint32_t done = 0; done < count; done += most) {
-        glUniform1ui(firstUniform, first + done);
-        glUniform1ui(countUniform, std::min(count - done, most));
-        glDrawArrays(GL_TRIANGLES, 0, 6);
-    }
+    for (size_t k = 0; k < first.size(); ++k)
+        for (uint32_t done = 0; done < uint32_t(count[k]); done += most) {
+            glUniform1ui(firstUniform, uint32_t(first[k]) + done);
+            glUniform1ui(countUniform, std::min(uint32_t(count[k]) - done, most));
+            glDrawArrays(GL_TRIANGLES, 0, 6);
+        }
 }
 
 void BundleTracer::begin(const BundleFrame& frame, const TilerOptions& options, uint32_t seed, bool recordStats) {

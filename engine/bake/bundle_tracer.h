@@ -65,11 +65,11 @@ struct BundleLimits {
     bool predict = true;       // size the buffers from the predictions (false: allocate the budget at once)
 };
 
-// Draws curved texels [first, first + count) (lib/curved_footprint.glsl) with
-// `program` (in use, their records bound, a res x res viewport): rectangles of
-// rows of res fragments from the viewport's corner, one fragment a texel
-// (lightmap/curved.vert).
-void drawCurvedTexelRun(GLuint program, int res, uint32_t first, uint32_t count);
+// Draws the runs of curved texels [first[k], first[k] + count[k])
+// (lib/curved_footprint.glsl) with `program` (in use, their records bound, a
+// res x res viewport): rectangles of rows of res fragments from the
+// viewport's corner, one fragment a texel (lightmap/curved.vert).
+void drawCurvedTexelRuns(GLuint program, int res, const std::vector<int32_t>& first, const std::vector<int32_t>& count);
 
 class BundleTracer {
 public:
@@ -85,7 +85,7 @@ public:
 
     // Curved texels (bake/curved_footprints.h) for the updates: per cluster,
     // its first texel (clusterFirst; empty: none), and what binds their
-    // records for a draw of them with the program given (drawCurvedTexelRun).
+    // records for a draw of them with the program given (drawCurvedTexelRuns).
     void setCurvedTexels(std::vector<uint32_t> clusterFirst, std::function<void(GLuint)> bind);
 
     // Both passes read the triangle and vertex buffers as SSBOs in chunks of

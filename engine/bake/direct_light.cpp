@@ -185,7 +185,7 @@ void addVisibleLight(Baker::Impl& m, const gl::Program& program, const gl::Progr
     if (m.curvedTexelCount()) {
         glUseProgram(curvedProgram.id());
         m.bindCurvedTexels(curvedProgram.id());
-        drawCurvedTexelRun(curvedProgram.id(), m.layout.resolution, 0, uint32_t(m.curvedTexelCount()));
+        drawCurvedTexelRuns(curvedProgram.id(), m.layout.resolution, {0}, {int32_t(m.curvedTexelCount())});
         glBindVertexArray(m.vao.id());
     }
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);

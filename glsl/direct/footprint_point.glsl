@@ -7,6 +7,7 @@
 uint vCurved;  // this fragment's curved texel (curvedFragmentIndex)
 #include "lib/curved_footprint.glsl"
 #else
+#include "lib/raster_frame.glsl"
 in vec3 vPosition;
 in vec3 vNormal;
 in vec3 vBary;
@@ -20,14 +21,21 @@ struct TexelFootprint {
     uvec3 footprint;
     vec3 centre;  // the texel's centre on its surface
     float size;   // its size on the surface (the longer of its steps along x and y)
-    // the light map fragment's steps per texel (flat texels)
-    vec3 positionDx, positionDy, normalDx, normalDy, baryDx, baryDy;
+    bool onPlane; // along its triangle's plane (the raster's texels, flat partial ones): `frame`
+    FlatFrame frame;
 };
 
 // A point of the footprint: position, shading normal, its triangle's plane's normal (any length).
 struct FootprintPoint {
     vec3 position, normal, plane;
 };
+
+// Sample `sampleIndex`'s point of a texel along its triangle's plane (frame f).
+FootprintPoint planeFootprintPoint(FlatFrame f, uvec3 footprint, uint sampleIndex) {
+    vec2 o = footprintOffset(f.bary, f.baryDx, f.baryDy, f.flags, footprint, sampleIndex);
+    return FootprintPoint(f.position + f.positionDx * o.x + f.positionDy * o.y,
+                          normalize(f.normal + f.normalDx * o.x + f.normalDy * o.y), cross(f.positionDx, f.positionDy));
+}
 
 #ifdef CURVED_FOOTPRINT
 bool texelFootprint(out TexelFootprint t) {
@@ -36,50 +44,34 @@ bool texelFootprint(out TexelFootprint t) {
     t.texel = curvedTexelTexel(head);
     t.footprint = texelFetch(footprint, t.texel, 0).rgb;
     t.centre = curvedTexelCentre(vCurved);
+    t.onPlane = curvedTexelIsFlat(head);
+    if (t.onPlane) t.frame = curvedFlatFrame(vCurved);
     CurvedTriangle owner = curvedTriangles[curvedRefs[head.z]];
     t.size = max(length(owner.positionDx.xyz), length(owner.positionDy.xyz));
     return true;
 }
 
 FootprintPoint footprintPoint(TexelFootprint t, uint sampleIndex) {
-    if (curvedTexelIsFlat(curvedTexels[vCurved])) {
-        // a flat partial texel: along its owner's plane, as the raster's texels
-        FlatFrame f = curvedFlatFrame(vCurved);
-        vec2 o = footprintOffset(f.bary, f.baryDx, f.baryDy, f.flags, t.footprint, sampleIndex);
-        return FootprintPoint(f.position + f.positionDx * o.x + f.positionDy * o.y,
-                              normalize(f.normal + f.normalDx * o.x + f.normalDy * o.y),
-                              cross(f.positionDx, f.positionDy));
-    }
+    if (t.onPlane) return planeFootprintPoint(t.frame, t.footprint, sampleIndex);  // a flat partial texel
     vec2 point;
     CurvedTriangle tri;
     curvedFootprintPoint(vCurved, t.footprint.xy, sampleIndex, point, tri);
-    vec2 q = point - tri.corners01.xy;
-    return FootprintPoint(tri.position.xyz + tri.positionDx.xyz * q.x + tri.positionDy.xyz * q.y,
-                          normalize(tri.normal.xyz + tri.normalDx.xyz * q.x + tri.normalDy.xyz * q.y),
+    return FootprintPoint(curvedTrianglePosition(tri, point), normalize(curvedTriangleNormal(tri, point)),
                           tri.faceNormal.xyz);
 }
 #else
 // False: a helper lane or a curved texel (its own draw's).
 bool texelFootprint(out TexelFootprint t) {
-    // derivatives before any return: they need the whole quad
-    t.positionDx = dFdx(vPosition);
-    t.positionDy = dFdy(vPosition);
-    t.normalDx = dFdx(vNormal);
-    t.normalDy = dFdy(vNormal);
-    t.baryDx = dFdx(vBary);
-    t.baryDy = dFdy(vBary);
+    t.frame = rasterFrame(vPosition, vNormal, vBary, vFlags);  // derivatives before any return
     if (gl_HelperInvocation) return false;
     t.texel = ivec3(ivec2(gl_FragCoord.xy), page);
     if ((texelFetch(texelCharts, t.texel, 0).r & TEXEL_CURVED) != 0u) return false;
     t.footprint = texelFetch(footprint, t.texel, 0).rgb;
     t.centre = vPosition;
-    t.size = max(length(t.positionDx), length(t.positionDy));
+    t.size = max(length(t.frame.positionDx), length(t.frame.positionDy));
+    t.onPlane = true;
     return true;
 }
 
-FootprintPoint footprintPoint(TexelFootprint t, uint sampleIndex) {
-    vec2 o = footprintOffset(vBary, t.baryDx, t.baryDy, vFlags, t.footprint, sampleIndex);
-    return FootprintPoint(vPosition + t.positionDx * o.x + t.positionDy * o.y,
-                          normalize(vNormal + t.normalDx * o.x + t.normalDy * o.y), cross(t.positionDx, t.positionDy));
-}
+FootprintPoint footprintPoint(TexelFootprint t, uint sampleIndex) { return planeFootprintPoint(t.frame, t.footprint, sampleIndex); }
 #endif

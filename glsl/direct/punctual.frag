@@ -35,7 +35,8 @@ void main() {
     for (uint k = 0u; k < CURVED_POINTS; ++k) sum += lightAt(footprintPoint(texel, k));
     vec3 light = sum / float(CURVED_POINTS);
 #else
-    vec3 light = lightAt(FootprintPoint(vPosition, normalize(vNormal), cross(texel.positionDx, texel.positionDy)));
+    FlatFrame f = texel.frame;
+    vec3 light = lightAt(FootprintPoint(vPosition, normalize(vNormal), cross(f.positionDx, f.positionDy)));
 #endif
     if (light != vec3(0.0)) addDirect(texel.texel, light);
 }

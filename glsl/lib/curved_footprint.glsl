@@ -16,7 +16,7 @@ layout(std430, binding = BINDING_CURVED_TEXELS) readonly buffer CurvedTexels { u
 
 // A partial texel (engine/layout/bake_mesh.h texelOwners: its centre on no
 // triangle, its square partly on a chart) that is flat: sampled as the
-// raster's texels are, along its owner's plane (curvedFlatTexel).
+// raster's texels are, along its owner's plane (curvedFlatFrame).
 bool curvedTexelIsFlat(uvec4 head) { return (head.w & CURVED_TEXEL_FLAT) != 0u; }
 uint curvedTexelTriangles(uvec4 head) { return head.w & ~CURVED_TEXEL_FLAT; }
 // Per curved texel, its triangles (indices into curvedTriangles), owner first.
@@ -69,7 +69,7 @@ bool curvedFragmentIndex(out uint index) {
 ivec3 curvedTexelTexel(uvec4 head) { return ivec3(int(head.x & 0xffffu), int(head.x >> 16u), int(head.y)); }
 
 // A curved texel's square's centre in page texels (`head`: its first uvec4).
-vec2 curvedTexelSquareCentre(uvec4 head) { return vec2(head.x & 0xffffu, head.x >> 16u) + 0.5; }
+vec2 curvedTexelSquareCentre(uvec4 head) { return vec2(curvedTexelTexel(head).xy) + 0.5; }
 
 // The point of segment [a, b] nearest p.
 vec2 nearestOnSegment(vec2 a, vec2 b, vec2 p) {
@@ -94,6 +94,12 @@ vec3 curvedTrianglePosition(CurvedTriangle c, vec2 p) {
     return c.position.xyz + c.positionDx.xyz * q.x + c.positionDy.xyz * q.y;
 }
 
+// Triangle c's shading normal at page point p, not normalised.
+vec3 curvedTriangleNormal(CurvedTriangle c, vec2 p) {
+    vec2 q = p - c.corners01.xy;
+    return c.normal.xyz + c.normalDx.xyz * q.x + c.normalDy.xyz * q.y;
+}
+
 // Curved texel `index`'s centre on its owner triangle (the first of its
 // triangles, which holds the centre, or of a partial texel the point nearest
 // it): where the leaf that takes its samples is.
@@ -109,14 +115,14 @@ FlatFrame curvedFlatFrame(uint index) {
     uvec4 head = curvedTexels[index];
     CurvedTriangle c = curvedTriangles[curvedRefs[head.z]];
     vec2 a = c.corners01.xy, e1 = c.corners01.zw - a, e2 = c.corner2.xy - a;
-    vec2 q = curvedTexelSquareCentre(head) - a;
+    vec2 centre = curvedTexelSquareCentre(head), q = centre - a;
     float det = e1.x * e2.y - e1.y * e2.x;
     // barycentrics 1 and 2 solve e1 b1 + e2 b2 = q; their steps per texel are the inverse's rows
     vec2 dB1 = vec2(e2.y, -e2.x) / det, dB2 = vec2(-e1.y, e1.x) / det;
     float b1 = dot(dB1, q), b2 = dot(dB2, q);
     FlatFrame f;
-    f.position = c.position.xyz + c.positionDx.xyz * q.x + c.positionDy.xyz * q.y;
-    f.normal = c.normal.xyz + c.normalDx.xyz * q.x + c.normalDy.xyz * q.y;
+    f.position = curvedTrianglePosition(c, centre);
+    f.normal = curvedTriangleNormal(c, centre);
     f.bary = vec3(1.0 - b1 - b2, b1, b2);
     f.baryDx = vec3(-dB1.x - dB2.x, dB1.x, dB2.x);
     f.baryDy = vec3(-dB1.y - dB2.y, dB1.y, dB2.y);

@@ -30,6 +30,7 @@
 #include "lib/rounding.glsl"
 #include "lib/bundle_frame.glsl"
 #include "lib/texel_footprint.glsl"
+#include "lib/raster_frame.glsl"
 
 #ifdef CURVED_FOOTPRINT
 // a curved texel (lib/curved_footprint.glsl curvedFragmentIndex: lightmap/curved.vert draws a fragment each)
@@ -353,8 +354,7 @@ bool curvedSample(out TexelSample s) {
     curvedFootprintPoint(vCurved, texelFetch(footprint, s.texel, 0).xy, footprintSample, point, tri);
     s.position = curvedTrianglePosition(tri, point);
     s.anchor = s.position;
-    vec2 q = point - tri.corners01.xy;
-    s.n = normalize(tri.normal.xyz + tri.normalDx.xyz * q.x + tri.normalDy.xyz * q.y);
+    s.n = normalize(curvedTriangleNormal(tri, point));
     s.ng = tri.faceNormal.xyz;
     s.texelSize = max(length(tri.positionDx.xyz), length(tri.positionDy.xyz));
     s.curvature = tri.corner2.w;
@@ -368,17 +368,7 @@ bool curvedSample(out TexelSample s) {
 bool triangleSample(out TexelSample s) {
     // the triangle's own plane, from screen derivatives (before any return:
     // derivatives need the whole quad)
-    FlatFrame f;
-    f.position = vPosition;
-    f.normal = vNormal;
-    f.bary = vBary;
-    f.positionDx = dFdx(vPosition);
-    f.positionDy = dFdy(vPosition);
-    f.normalDx = dFdx(vNormal);
-    f.normalDy = dFdy(vNormal);
-    f.baryDx = dFdx(vBary);
-    f.baryDy = dFdy(vBary);
-    f.flags = vFlags;
+    FlatFrame f = rasterFrame(vPosition, vNormal, vBary, vFlags);
     // llvmpipe runs helper lanes through the walk with undefined loads, where they
     // spin; they have no side effects to make, so leave at once (GLSL 4.50).
     if (gl_HelperInvocation) return false;

@@ -130,11 +130,13 @@ TEST(PartialTexelBake, LedgeUnderASkyReadsTheMeanOverItsPart) {
     expectLedgeRow(kV0, kDepth, 0.015, "ledge under a sky");
 }
 
-// The same ledge with its chart past the row's centres: no centre of the row
-// is on it, so the raster misses the row. Before 2026-12-04 it was padding
-// (not covered; dilated from the wall's texels or none); now each texel is its
-// own (a partial texel, drawn as a point by every light pass). Measured:
-// TODO. Tolerance: as above.
+// The same ledge, 0.3 m deep, with its chart past the row's centres (v over
+// [0.6, 0.9] of the row): no centre of the row is on it, so the raster misses
+// the row. Before 2026-12-03 (evening) it was padding (not covered: the test
+// failed at its first ASSERT); now each texel is its own (a partial texel,
+// layout/bake_mesh.h texelOwners, drawn apart by every light pass). Measured:
+// row mean 0.5202 against 0.5251 (-0.95 %), worst texel 2.6 %. Tolerance: as
+// above, the row's mean within 1.5 %, every texel within 15 %.
 TEST(PartialTexelBake, LedgeMissingItsTexelCentresIsBakedAsTexelsOfItsOwn) {
     BB_REQUIRE_GL();
     expectLedgeRow(kV0Partial, kDepthPartial, 0.015, "ledge off its texels' centres");
