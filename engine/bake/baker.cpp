@@ -101,6 +101,7 @@ nlohmann::json BakeStats::toJson() const {
     const double drawnTiles = double(std::max<int64_t>(tilesDrawn, 1)) * double(std::max<int64_t>(triangles, 1));
     j["tiles"] = {{"drawn", tilesDrawn}, {"per_direction_mean", meanTiles}, {"per_direction_max", maxTiles},
                   {"leaves_per_direction_mean", meanLeaves},
+                  {"curvature_refined_triangles", curvatureRefinedTriangles},
                   {"overflows_redrawn", overflows},
                   {"predicted_over_actual_nodes", {{"min", pct(0)}, {"p10", pct(0.1)}, {"median", pct(0.5)},
                                                    {"p90", pct(0.9)}, {"max", pct(1)}, {"count", predictedOverActual.size()}}},
@@ -531,7 +532,13 @@ Status Baker::Impl::init(const Scene& scene) {
         if (!analyzer) return analyzer.status();
         auto result = (*analyzer)->analyze(mesh, layout.resolution);
         if (!result) return result.status();
-        setClusterImportance(mesh, clusters, result->importance.importance);
+        std::vector<float>& importance = result->importance.importance;
+        for (size_t t = 0; t < importance.size(); ++t) {
+            const float raised = curvatureImportance(&mesh.vertices[3 * t], importance[t], tilerOptions.pixelsPerTexel);
+            stats.curvatureRefinedTriangles += raised > importance[t];
+            importance[t] = raised;
+        }
+        setClusterImportance(mesh, clusters, importance);
         stats.secondsImportance = secondsSince(t);
     }
 

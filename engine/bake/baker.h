@@ -121,6 +121,7 @@ struct BakeStats {
     std::vector<int> tilesPerDirection;
     std::vector<int> leavesPerDirection;
     std::vector<float> tilePixelSizes;        // per tile drawn without overflow, scene units
+    int64_t curvatureRefinedTriangles = 0;    // receivers whose curvature asks finer pixels than their texels
     int64_t triangles = 0;
     int64_t clusters = 0;
     int64_t bundleTrianglesDrawn = 0;         // over all bundle-pass draws (culling: << triangles x tiles)

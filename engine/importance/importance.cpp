@@ -34,6 +34,20 @@ float areaRatio(const BakeVertex* t, int resolution) {
     return r >= double(MAX_AREA_RATIO) ? MAX_AREA_RATIO : float(r);
 }
 
+float curvatureImportance(const BakeVertex* t, float importance, double pixelsPerTexel) {
+    if (!(importance > 0.0f) || importance >= MAX_AREA_RATIO) return importance;
+    double curvature = 0.0;  // 1 / scene units
+    for (int k = 0; k < 3; ++k) {
+        const BakeVertex &a = t[k], &b = t[(k + 1) % 3];
+        const double length = glm::length(glm::dvec3(b.position) - glm::dvec3(a.position));
+        if (length > 0.0) curvature = std::max(curvature, glm::length(glm::dvec3(b.normal) - glm::dvec3(a.normal)) / length);
+    }
+    // pixel = 1 / (pixelsPerTexel sqrt(I)) = R x kCurvaturePixelShare
+    const double wanted = curvature / (pixelsPerTexel * kCurvaturePixelShare);
+    const double raised = std::min(wanted * wanted, kMaxCurvatureRefine * kMaxCurvatureRefine * double(importance));
+    return std::max(importance, float(std::min(raised, double(MAX_AREA_RATIO))));
+}
+
 namespace {
 // Neighbours x_0..x_3 in the supplement's cyclic order (j = i + 1 mod 4 is adjacent).
 constexpr int NEIGHBOUR_DX[4] = {1, 0, -1, 0};

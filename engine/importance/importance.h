@@ -90,6 +90,21 @@ double worldArea(const BakeVertex* triangle);                    // A_o, 3 verti
 double texelArea(const BakeVertex* triangle, int resolution);    // A_l
 float areaRatio(const BakeVertex* triangle, int resolution);
 
+// An addition to the paper (issue 11): a curved surface needs pixels finer
+// than its texels do where it bends within a pixel. A tube thinner than a
+// pixel (mixed_lighting's chair piping, 7 mm across under 12 mm pixels) is
+// seen by few pixel rays, and its texels' samples find their own surface in
+// a neighbour's pixel or none: it read up to 3x the reference. The radius of
+// curvature R is 1 / the largest turn of the shading normals per unit length
+// along the triangle's edges (flat triangles: none). This returns I(t)
+// raised so that the bundle pixel is at most R x kCurvaturePixelShare, and
+// at most kMaxCurvatureRefine times finer than `importance` asks (the cost
+// stays bounded on a finely bevelled asset); I(t) itself where it already
+// asks for that, and 0 where it is 0 (not a receiver).
+inline constexpr double kCurvaturePixelShare = 0.5;
+inline constexpr double kMaxCurvatureRefine = 2.5;
+float curvatureImportance(const BakeVertex* triangle, float importance, double pixelsPerTexel);
+
 // Eq. (3) at texel (x, y) of a mapped texel: neighbours (x+1,y), (x,y+1),
 // (x-1,y), (x,y-1); w = 1 where a neighbour is mapped (to any surface: the
 // supplement's "mapped to an object"), 0 outside the page or unmapped. The

@@ -58,6 +58,30 @@ TEST(ImportanceCpu, AreaRatioIsTexelsPerWorldArea) {
     EXPECT_EQ(areaRatio(flatWorld, 64), MAX_AREA_RATIO);
 }
 
+// The curvature term (importance.h curvatureImportance): a triangle of a
+// tube of radius R (its shading normals turning by 2 sin(a / 2) over the
+// chord 2 R sin(a / 2), i.e. 1 / R per unit length) asks for pixels of R / 2,
+// I = (2 / (R pixelsPerTexel))^2, at most 2.5^2 x its own I(t); flat
+// triangles and non-receivers (I = 0) keep theirs.
+TEST(ImportanceCpu, CurvatureAsksForPixelsOfHalfTheRadiusWithinACap) {
+    const double radius = 0.1, a = 0.3, ppt = 2.0;
+    BakeVertex t[3];
+    const glm::vec3 n0(0.0f, 1.0f, 0.0f), n1(std::sin(a), std::cos(a), 0.0f);
+    t[0].position = glm::vec4(glm::vec3(radius) * n0, 1.0f);
+    t[1].position = glm::vec4(glm::vec3(radius) * n1, 1.0f);
+    t[2].position = glm::vec4(glm::vec3(radius) * n0 + glm::vec3(0.0f, 0.0f, 1.0f), 1.0f);
+    t[0].normal = glm::vec4(n0, 0.0f);
+    t[1].normal = glm::vec4(n1, 0.0f);
+    t[2].normal = glm::vec4(n0, 0.0f);
+    const double wanted = std::pow(2.0 / (radius * ppt), 2.0);  // 100
+    EXPECT_NEAR(curvatureImportance(t, 50.0f, ppt), wanted, 1e-3 * wanted);   // raised to R / 2 pixels
+    EXPECT_NEAR(curvatureImportance(t, 4.0f, ppt), 6.25 * 4.0, 1e-4);         // capped at 2.5x finer pixels
+    EXPECT_EQ(curvatureImportance(t, 500.0f, ppt), 500.0f);                   // already finer
+    EXPECT_EQ(curvatureImportance(t, 0.0f, ppt), 0.0f);                       // not a receiver
+    for (BakeVertex& v : t) v.normal = glm::vec4(0.0f, 1.0f, 0.0f, 0.0f);   // flat
+    EXPECT_EQ(curvatureImportance(t, 50.0f, ppt), 50.0f);
+}
+
 // Eq. (3) on a grid of spacing h is exactly 1/h^2 = texels per world area,
 // inside (4 / 4h^2), on edges (3 / 3h^2) and in corners (2 / 2h^2).
 TEST(ImportanceCpu, Eq3OnAUniformGridIsOneOverHSquared) {
