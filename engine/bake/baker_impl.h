@@ -185,6 +185,7 @@ struct Baker::Impl {
     // noise.cpp: the relative noise now (stats.noiseRelative), kept in the
     // history; stops the bake (directionsGoal) when --target-noise is reached
     void estimateNoise();
+    double noiseHalvesFactor() const;  // noise.cpp
     int directionsGoal() const { return stats.stoppedAtTargetNoise ? stats.directionsDone : options.directions; }
 };
 

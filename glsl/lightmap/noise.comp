@@ -2,11 +2,10 @@
 // The noise estimate (engine/bake/noise.cpp), per sampled texel: the running
 // mean splits into the odd directions' half (halfAccum, kept by the update
 // pass at every halfStride-th texel) and the even directions' (the whole
-// minus the odd: M_e = (M W - M_o W_o) / (W - W_o)). With variances s^2/W_e
-// and s^2/W_o, E[(M_e - M_o)^2] = s^2 (1/W_e + 1/W_o) and the whole's is s^2/W,
-// so (M_e - M_o)^2 W_e W_o / W^2 estimates it (a quarter at equal halves). Writes (sum over RGB of that
-// variance, sum over RGB of L_lm, 1) for texels where both halves hold
-// samples, zeros elsewhere; the CPU sums.
+// minus the odd: M_e = (M W - M_o W_o) / (W - W_o)). Writes (sum over RGB of
+// (M_e - M_o)^2, sum over RGB of L_lm, 1) for texels where both halves hold
+// samples, zeros elsewhere; the CPU sums and scales by the halves' weights
+// (noise.cpp halvesFactor).
 #include "shared/bundle_layout.h"
 #include "lib/rounding.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -33,5 +32,5 @@ void main() {
     vec3 even = (whole.rgb * whole.a - odd.rgb * odd.a) / evenWeight;
     vec3 d = even - odd.rgb;
     vec3 l = whole.rgb + imageLoad(directMap, ivec3(h.xy * halfStride, h.z)).rgb;
-    imageStore(target, h, vec4(dot(d, d) * evenWeight * odd.a / (whole.a * whole.a), l.r + l.g + l.b, 1.0, 0.0));
+    imageStore(target, h, vec4(dot(d, d), l.r + l.g + l.b, 1.0, 0.0));
 }
