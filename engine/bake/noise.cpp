@@ -10,7 +10,6 @@
 // sqrt(mean variance) / mean L_lm over the sampled texels, the measure
 // `bundlebake compare` reports as rel_rmse against a reference. It is noise
 // only: a bias both halves share (a source both miss) is not in it.
-#include <algorithm>
 #include <cmath>
 
 #include "bake/baker_impl.h"
@@ -32,8 +31,9 @@ namespace bb {
 // directions that M is (mixed_lighting, ramp power 1024: 0.27 % after 17
 // directions against 13.8 % true error, and `--target-noise 0.01` stopped there).
 double Baker::Impl::noiseHalvesFactor() const {
-    double top = -1e300;
-    for (int k = 0; k < stats.directionsDone; ++k) top = std::max(top, rampLogWeight(k / shareCount()));
+    if (stats.directionsDone < 2) return 0.0;
+    // the ramp never falls: the latest direction's weight is the largest
+    const double top = rampLogWeight((stats.directionsDone - 1) / shareCount());
     double w[2] = {0, 0}, s[2] = {0, 0};  // even, odd directions
     for (int k = 0; k < stats.directionsDone; ++k) {
         const double v = std::exp(rampLogWeight(k / shareCount()) - top);

@@ -5,7 +5,7 @@
 // minus the odd: M_e = (M W - M_o W_o) / (W - W_o)). Writes (sum over RGB of
 // (M_e - M_o)^2, sum over RGB of L_lm, 1) for texels where both halves hold
 // samples, zeros elsewhere; the CPU sums and scales by the halves' weights
-// (noise.cpp halvesFactor).
+// (noise.cpp noiseHalvesFactor).
 #include "shared/bundle_layout.h"
 #include "lib/rounding.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
