@@ -523,7 +523,6 @@ Status Baker::Impl::init(const Scene& scene) {
     // culling units: the triangles reordered into spatially coherent clusters
     clusters = clusterMesh(mesh);
     stats.triangles = int64_t(mesh.triangles.size());
-    stats.clusters = int64_t(clusters.size());
     // importance (supplement §1) decides each leaf's pixel size
     {
         auto t = Clock::now();
@@ -539,6 +538,7 @@ Status Baker::Impl::init(const Scene& scene) {
             importance[t] = raised;
         }
         setClusterImportance(mesh, clusters, importance);
+        stats.clusters = int64_t(clusters.size());
         stats.secondsImportance = secondsSince(t);
     }
 

@@ -14,6 +14,10 @@ namespace {
 // triangle that covers a pixel centre of the tile.
 constexpr double RECT_PAD = 1e-6;
 
+// A cluster drawn at its largest I(t) may make at most this many times the
+// fragments its triangles would at their own (setClusterImportance).
+constexpr double kClusterCost = 2.0;
+
 struct Square {
     double x0, y0, x1, y1;
 };
@@ -113,6 +117,16 @@ struct QuadtreeBuilder {
     }
 };
 
+// A cluster's world bounds from its triangles' vertices.
+void setBounds(const BakeMesh& mesh, Cluster& c) {
+    c.boundsMin = glm::vec3(3e38f);
+    c.boundsMax = glm::vec3(-3e38f);
+    for (uint32_t v = 3 * c.first; v < 3 * (c.first + c.count); ++v) {
+        c.boundsMin = glm::min(c.boundsMin, glm::vec3(mesh.vertices[v].position));
+        c.boundsMax = glm::max(c.boundsMax, glm::vec3(mesh.vertices[v].position));
+    }
+}
+
 }  // namespace
 
 double pixelForImportance(float importance, double pixelsPerTexel) {
@@ -172,12 +186,7 @@ std::vector<Cluster> clusterMesh(BakeMesh& mesh, uint32_t maxTriangles) {
         c.first = begin;
         c.count = end - begin;
         c.page = mesh.triangles[begin].page;
-        c.boundsMin = glm::vec3(3e38f);
-        c.boundsMax = glm::vec3(-3e38f);
-        for (uint32_t v = 3 * begin; v < 3 * end; ++v) {
-            c.boundsMin = glm::min(c.boundsMin, glm::vec3(mesh.vertices[v].position));
-            c.boundsMax = glm::max(c.boundsMax, glm::vec3(mesh.vertices[v].position));
-        }
+        setBounds(mesh, c);
         clusters.push_back(c);
     }
     return clusters;
@@ -185,30 +194,78 @@ std::vector<Cluster> clusterMesh(BakeMesh& mesh, uint32_t maxTriangles) {
 
 void setClusterImportance(BakeMesh& mesh, std::vector<Cluster>& clusters, std::vector<float>& importance) {
     CHECK_EQ(importance.size(), mesh.triangles.size());
+    const auto area = [&](uint32_t t) {
+        const glm::dvec3 a(mesh.vertices[3 * size_t(t)].position), b(mesh.vertices[3 * size_t(t) + 1].position),
+            c(mesh.vertices[3 * size_t(t) + 2].position);
+        return 0.5 * glm::length(glm::cross(b - a, c - a));
+    };
+    std::vector<Cluster> out;
+    out.reserve(clusters.size());
     std::vector<uint32_t> order;
     std::vector<BakeTriangle> triangles;
     std::vector<BakeVertex> vertices;
     std::vector<float> values;
-    for (Cluster& c : clusters) {
-        order.resize(c.count);
-        std::iota(order.begin(), order.end(), c.first);
-        std::stable_partition(order.begin(), order.end(), [&](uint32_t t) { return importance[t] > 0.0f; });
+    for (const Cluster& cluster : clusters) {
+        order.resize(cluster.count);
+        std::iota(order.begin(), order.end(), cluster.first);
+        // drawn at its largest I, a cluster makes sum A(t) max I fragments
+        // where its receivers alone would make sum A(t) I(t): where that is
+        // more than kClusterCost times over (a small, finely pixelled prop on
+        // a wide floor), its triangles are sorted by I and cut into runs that
+        // are not
+        double atMax = 0, own = 0;
+        float imax = 0;
+        for (uint32_t t : order) imax = std::max(imax, importance[t]);
+        for (uint32_t t : order)
+            if (importance[t] > 0.0f) {
+                atMax += area(t) * imax;
+                own += area(t) * importance[t];
+            }
+        const bool mixed = atMax > kClusterCost * own;
+        if (mixed)
+            std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return importance[a] > importance[b]; });
+        else
+            std::stable_partition(order.begin(), order.end(), [&](uint32_t t) { return importance[t] > 0.0f; });
         triangles.clear();
         vertices.clear();
         values.clear();
-        c.maxImportance = 0.0f;
-        c.receivers = 0;
         for (uint32_t t : order) {
             triangles.push_back(mesh.triangles[t]);
             for (int k = 0; k < 3; ++k) vertices.push_back(mesh.vertices[3 * size_t(t) + k]);
             values.push_back(importance[t]);
-            c.maxImportance = std::max(c.maxImportance, importance[t]);
-            c.receivers += importance[t] > 0.0f;
         }
-        std::copy(triangles.begin(), triangles.end(), mesh.triangles.begin() + c.first);
-        std::copy(vertices.begin(), vertices.end(), mesh.vertices.begin() + 3 * size_t(c.first));
-        std::copy(values.begin(), values.end(), importance.begin() + c.first);
+        std::copy(triangles.begin(), triangles.end(), mesh.triangles.begin() + cluster.first);
+        std::copy(vertices.begin(), vertices.end(), mesh.vertices.begin() + 3 * size_t(cluster.first));
+        std::copy(values.begin(), values.end(), importance.begin() + cluster.first);
+
+        // runs [first, first + count): receivers first, then the triangles that only occlude
+        Cluster c = cluster;
+        c.count = 0;
+        c.maxImportance = 0.0f;
+        c.receivers = 0;
+        atMax = own = 0;
+        for (uint32_t t = cluster.first; t < cluster.first + cluster.count; ++t) {
+            const float i = importance[t];
+            const double a = i > 0.0f ? area(t) : 0.0;
+            if (mixed && c.receivers > 0 && i > 0.0f && (atMax + a * c.maxImportance) > kClusterCost * (own + a * i)) {
+                setBounds(mesh, c);
+                out.push_back(c);
+                c.first = t;
+                c.count = 0;
+                c.maxImportance = 0.0f;
+                c.receivers = 0;
+                atMax = own = 0;
+            }
+            c.maxImportance = std::max(c.maxImportance, i);
+            c.receivers += i > 0.0f;
+            atMax += a * c.maxImportance;
+            own += a * i;
+            ++c.count;
+        }
+        setBounds(mesh, c);
+        out.push_back(c);
     }
+    clusters = std::move(out);
 }
 
 std::vector<ClusterView> projectClusters(const BakeMesh& mesh, const std::vector<Cluster>& clusters,

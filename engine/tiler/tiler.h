@@ -66,7 +66,12 @@ std::vector<Cluster> clusterMesh(BakeMesh& mesh, uint32_t maxTriangles = 256);
 // (BakeMesh order), reordering each cluster's triangles (and `importance`)
 // so the receivers come first: the update pass then draws only triangles
 // with texel centres (I(t) = 0 exactly when a triangle covers none, Eq. 4).
-// Stable within both groups, so deterministic.
+// A cluster whose receivers would make more than twice their own fragments
+// at its largest I (sum A(t) max I against sum A(t) I(t): a thin tube's 96
+// triangles and the two of the wide floor it lies on) is sorted by I and cut
+// into runs that do not, each a cluster of its own: a leaf takes its pixel
+// from the clusters it meets, and the floor is not drawn at the tube's pixel
+// wherever it reaches. Stable, so deterministic.
 void setClusterImportance(BakeMesh& mesh, std::vector<Cluster>& clusters, std::vector<float>& importance);
 
 // The bundle plane of one direction: rays travel along +dir; (u, v) are plane
