@@ -466,8 +466,11 @@ void main() {
     // A tenth of it (about 3 float ulps of the scene's extent) is enough for
     // every radiance test. The sun pass keeps all of it: with a tenth a
     // floating cube's face read one sun sample shadowed at its bottom edge
-    // (0.57 % of its light in one texel, SunBake.BoxCastsShadowWhereGeometrySays;
-    // not understood).
+    // (0.57 % of its light in one texel, SunBake.BoxCastsShadowWhereGeometrySays),
+    // a node seen from the looking side within the margin: likely the bottom
+    // face's at the shared edge, its depth rounded to in front of the side's
+    // (a depth plane's rounding grows with its slope over the leaf, not only
+    // with the scene's extent; not confirmed).
 #ifdef SUN_PASS
     float skip = depthBias;
 #else
