@@ -127,7 +127,8 @@ nlohmann::json BakeStats::toJson() const {
                    {"node_capacity", nodeCapacity}, {"peak_nodes_per_tile", peakNodesPerTile},
                    {"node_buffer_bytes", nodeBufferBytes}, {"head_image_bytes", headImageBytes}, {"bytes_per_node", 12}};
     j["lightmap"] = {{"texels", lightmapTexels}, {"covered_texels", coveredTexels}, {"shared_texels", sharedTexels},
-                   {"curved_texels", curvedTexels}, {"partial_texels", partialTexels}};
+                   {"curved_texels", curvedTexels}, {"partial_texels", partialTexels},
+                   {"exact_footprint_texels", exactFootprintTexels}};
     j["direct_light"] = {{"explicit_emitters", explicitEmitters}, {"emitter_samples", emitterSampleCount}};
     double bundleSeconds = secondsBundle > 0 ? secondsBundle : 1e-9;
     double updateSeconds = secondsUpdate > 0 ? secondsUpdate : 1e-9;
@@ -364,7 +365,10 @@ void Baker::Impl::coveragePass() {
         gl::readTexture(dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, codes.data());
         std::vector<uint8_t> partial;
         const std::vector<int32_t> owners = texelOwners(mesh, p, res, &partial);
-        curved[size_t(p)] = curvedTexels(mesh, p, res, owners, charts, partial);
+        const std::vector<TexelFootprint> footprints = texelFootprints(mesh, p, res, owners, charts);
+        std::vector<uint8_t> inexact(footprints.size());
+        for (size_t i = 0; i < inexact.size(); ++i) inexact[i] = footprints[i].inexact;
+        curved[size_t(p)] = curvedTexels(mesh, p, res, owners, charts, partial, 0.02, inexact);
         std::erase_if(curved[size_t(p)], [&](const CurvedTexel& c) {
             if (codes[c.texel] != DILATION_SELF) return true;
             curvedRefs += int64_t(c.triangles.size());
@@ -377,6 +381,7 @@ void Baker::Impl::coveragePass() {
         });
         stats.coveredTexels += std::count(codes.begin(), codes.end(), uint8_t(DILATION_SELF));
         for (size_t i = 0; i < codes.size(); ++i) stats.partialTexels += partial[i] && codes[i] == DILATION_SELF;
+        for (const CurvedTexel& c : curved[size_t(p)]) stats.exactFootprintTexels += c.exact;
         chartNeighbourBits(codes, owners, charts, res, neighbours);
         for (size_t i = 0; i < owners.size(); ++i)
             ownerCharts[i] = uint16_t(owners[i] < 0 ? TEXEL_CHART_MASK : charts[size_t(owners[i])] & TEXEL_CHART_MASK);
@@ -384,7 +389,6 @@ void Baker::Impl::coveragePass() {
         gl::writeTexture(texelCharts.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_SHORT, 2, ownerCharts.data());
         stats.sharedTexels += int64_t(sharedTexels(mesh, p, res, owners, charts));
         {
-            const std::vector<TexelFootprint> footprints = texelFootprints(mesh, p, res, owners, charts);
             std::vector<glm::uvec3> packed(footprints.size());
             for (size_t i = 0; i < packed.size(); ++i) {
                 const TexelFootprint& f = footprints[i];

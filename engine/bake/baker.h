@@ -116,6 +116,7 @@ struct BakeStats {
     int64_t curvedTexels = 0;  // covered texels whose chart folds or curves within them (layout/bake_mesh.h curvedTexels)
                                // and partial texels (texelOwners), which are drawn as curved ones
     int64_t partialTexels = 0;      // covered texels whose centre is on no chart (layout/bake_mesh.h texelOwners)
+    int64_t exactFootprintTexels = 0;  // flat ones among the curved whose points their triangles keep (CurvedTexel::exact)
     int64_t curvedTexelBytes = 0;   // their records (bake/curved_footprints.h), part of lightmapStateBytes
     std::vector<double> predictedOverActual;  // per tile: predicted nodes / actual nodes
     std::vector<int> tilesPerDirection;

@@ -77,7 +77,8 @@ CurvedFootprints buildCurvedFootprints(const BakeMesh& mesh, const std::vector<C
             out.refs.push_back(it->second);
         }
         out.texels.push_back(glm::uvec4(x | (y << 16), e.page, firstRef,
-                                        uint32_t(texel.triangles.size()) | (texel.flat ? CURVED_TEXEL_FLAT : 0u)));
+                                        uint32_t(texel.triangles.size()) | (texel.flat ? CURVED_TEXEL_FLAT : 0u) |
+                                            (texel.exact ? CURVED_TEXEL_EXACT : 0u)));
     }
     for (size_t c = 0; c < clusters.size(); ++c) out.clusterFirst[c + 1] += out.clusterFirst[c];
     return out;

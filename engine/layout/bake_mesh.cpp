@@ -384,6 +384,16 @@ std::vector<TexelFootprint> texelFootprints(const BakeMesh& mesh, int page, int 
         }
         out[i].edge = best;
         out[i].area = uint8_t(std::lround(255.0 * accepted));
+        // how far the test (with the edge) is from the chart, on the grid
+        const std::pair<glm::dvec2, double> side = decodeFootprintEdge(best);
+        int on = 0, wrong = 0;
+        for (int k = 0; k < N * N; ++k) {
+            const bool taken = base[size_t(k)] && (best == 0 || within(side, point(k)));
+            on += exact[size_t(k)];
+            wrong += taken != bool(exact[size_t(k)]);
+        }
+        out[i].inexact = wrong > kInexactFootprintShare * on;
+        if (out[i].inexact) out[i].area = uint8_t(std::lround(255.0 * on / (N * N)));
     }
     for (size_t i = 0; i < mask.size(); ++i) {
         out[i].cells = mask[i];
@@ -424,7 +434,7 @@ bool texelAffine(const BakeMesh& mesh, uint32_t t, int res, bool normals, TexelA
 
 std::vector<CurvedTexel> curvedTexels(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,
                                       const std::vector<uint32_t>& chart, const std::vector<uint8_t>& partial,
-                                      double departure) {
+                                      double departure, const std::vector<uint8_t>& inexact) {
     // every triangle of a covered texel's chart overlapping its square with
     // area, and how far it leaves the owner's plane there (at the corners of
     // its piece of the square), in the owner's texel sizes
@@ -466,8 +476,9 @@ std::vector<CurvedTexel> curvedTexels(const BakeMesh& mesh, int page, int res, c
         for (end = begin; end < overlaps.size() && overlaps[end].texel == i; ++end)
             worst = std::max(worst, overlaps[end].departure);
         const bool isPartial = !partial.empty() && partial[i];
-        if (!(worst > departure) && !isPartial) continue;
-        CurvedTexel texel{i, {o}, !(worst > departure)};
+        const bool isInexact = !inexact.empty() && inexact[i];
+        if (!(worst > departure) && !isPartial && !isInexact) continue;
+        CurvedTexel texel{i, {o}, !(worst > departure), isInexact && !(worst > departure)};
         for (size_t k = begin; k < end; ++k)
             if (overlaps[k].triangle != o) texel.triangles.push_back(overlaps[k].triangle);
         curved.push_back(std::move(texel));

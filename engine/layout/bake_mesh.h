@@ -111,7 +111,16 @@ struct TexelFootprint {
     // 32 grid of points): the update pass expects a pixel centre to cross it
     // about area x (its square's projection in pixels) times (footprintPixel).
     uint8_t area = 0;
+    // The test disagrees with the chart on more than kInexactFootprintShare of
+    // the part of the square on it (points taken off it or left out): a chart
+    // part the owner's border edges, the cells and one more edge do not hold,
+    // as at the corner of a ring a fifth of a texel wide, whose other arm lies
+    // past the owner's border line. Such a texel is drawn as a point
+    // (curvedTexels, CurvedTexel::exact) and keeps the points one of its
+    // triangles holds; `area` is then that part's (the grid's count).
+    bool inexact = false;
 };
+constexpr double kInexactFootprintShare = 0.1;
 std::vector<TexelFootprint> texelFootprints(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,
                                             const std::vector<uint32_t>& chart);
 
@@ -139,6 +148,9 @@ struct CurvedTexel {
     // as a point (the raster misses its centre) but sampled as flat texels
     // are, along its owner's plane.
     bool flat = false;
+    // A flat one whose flat footprint test is inexact (TexelFootprint): its
+    // points are kept where one of `triangles` holds them instead.
+    bool exact = false;
 };
 
 // The page's curved texels in texel order: of each covered texel, the part of
@@ -146,10 +158,12 @@ struct CurvedTexel {
 // chart's triangles, against the same points on the owner's plane extended;
 // departures measured in the owner's texel size (the longer of its per-texel
 // steps along x and y). Every partial texel (`partial`, texelOwners' flags;
-// empty: none) is one, flat where it does not depart.
+// empty: none) is one, flat where it does not depart; so is every texel whose
+// flat footprint test is inexact (`inexact`, texelFootprints'; empty: none),
+// with `exact` set.
 std::vector<CurvedTexel> curvedTexels(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,
                                       const std::vector<uint32_t>& chart, const std::vector<uint8_t>& partial = {},
-                                      double departure = 0.02);
+                                      double departure = 0.02, const std::vector<uint8_t>& inexact = {});
 
 // Triangle t's position (normal) as an affine function of page texel
 // coordinates: at(q) = at0 + dx * (q.x - q0.x) + dy * (q.y - q0.y). False where

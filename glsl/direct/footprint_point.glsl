@@ -46,6 +46,7 @@ bool texelFootprint(out TexelFootprint t) {
     t.centre = curvedTexelCentre(vCurved);
     t.onPlane = curvedTexelIsFlat(head);
     if (t.onPlane) t.frame = curvedFlatFrame(vCurved);
+    useFootprintOf(vCurved);
     CurvedTriangle owner = curvedTriangles[curvedRefs[head.z]];
     t.size = max(length(owner.positionDx.xyz), length(owner.positionDy.xyz));
     return true;

@@ -11,14 +11,14 @@
 //
 // Needs shared/bundle_layout.h, lib/rounding.glsl and lib/texel_footprint.glsl.
 
-// A curved texel: uvec4(x | y << 16, page, first ref, ref count | CURVED_TEXEL_FLAT).
+// A curved texel: uvec4(x | y << 16, page, first ref, ref count | CURVED_TEXEL_FLAT | CURVED_TEXEL_EXACT).
 layout(std430, binding = BINDING_CURVED_TEXELS) readonly buffer CurvedTexels { uvec4 curvedTexels[]; };
 
 // A partial texel (engine/layout/bake_mesh.h texelOwners: its centre on no
 // triangle, its square partly on a chart) that is flat: sampled as the
 // raster's texels are, along its owner's plane (curvedFlatFrame).
 bool curvedTexelIsFlat(uvec4 head) { return (head.w & CURVED_TEXEL_FLAT) != 0u; }
-uint curvedTexelTriangles(uvec4 head) { return head.w & ~CURVED_TEXEL_FLAT; }
+uint curvedTexelTriangles(uvec4 head) { return head.w & ~(CURVED_TEXEL_FLAT | CURVED_TEXEL_EXACT); }
 // Per curved texel, its triangles (indices into curvedTriangles), owner first.
 layout(std430, binding = BINDING_CURVED_REFS) readonly buffer CurvedRefs { uint curvedRefs[]; };
 // engine/bake/curved_footprints.h CurvedTriangle: the triangle in page texels
@@ -67,6 +67,23 @@ bool curvedFragmentIndex(out uint index) {
 
 // A curved texel's texel in its page (`head`: its first uvec4).
 ivec3 curvedTexelTexel(uvec4 head) { return ivec3(int(head.x & 0xffffu), int(head.x >> 16u), int(head.y)); }
+
+// Whether the point `offset` texels from curved texel `index`'s square's
+// centre lies off its triangles (lib/texel_footprint.glsl offChart, for a
+// CURVED_TEXEL_EXACT texel).
+bool exactOffChart(uint index, vec2 offset) {
+    uvec4 head = curvedTexels[index];
+    vec2 point = vec2(curvedTexelTexel(head).xy) + 0.5 + offset;
+    for (uint k = 0u; k < curvedTexelTriangles(head); ++k)
+        if (curvedTriangleHolds(curvedTriangles[curvedRefs[head.z + k]], point)) return false;
+    return true;
+}
+
+// The footprint test for curved texel `index`'s flat samples: its triangles'
+// where its flat test is inexact, else the flat test (offChart).
+void useFootprintOf(uint index) {
+    exactFootprint = (curvedTexels[index].w & CURVED_TEXEL_EXACT) != 0u ? index : NO_EXACT_FOOTPRINT;
+}
 
 // A curved texel's square's centre in page texels (`head`: its first uvec4).
 vec2 curvedTexelSquareCentre(uvec4 head) { return vec2(curvedTexelTexel(head).xy) + 0.5; }

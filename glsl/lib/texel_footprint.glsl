@@ -52,6 +52,15 @@ bool insideFootprintEdge(uint code, vec2 offset) {
 // The part of the texel's square the footprint test takes as on its chart (0..1).
 float footprintArea(uvec3 footprint) { return max(float(footprint.z >> 24u), 1.0) / 255.0; }
 
+#ifdef CURVED_FOOTPRINT
+// A flat curved texel whose flat test is inexact (CURVED_TEXEL_EXACT): its
+// index, set by its pass before it samples; its triangles then decide
+// (lib/curved_footprint.glsl exactOffChart). NO_EXACT_FOOTPRINT: the test below.
+const uint NO_EXACT_FOOTPRINT = 0xffffffffu;
+uint exactFootprint = NO_EXACT_FOOTPRINT;
+bool exactOffChart(uint index, vec2 offset);
+#endif
+
 // Whether the point `offset` texels from the fragment's centre lies off its
 // chart: past an edge of the fragment's triangle that is a chart border
 // (exact), in an eighth-texel cell of the square no part of the chart touches,
@@ -61,8 +70,11 @@ float footprintArea(uvec3 footprint) { return max(float(footprint.z >> 24u), 1.0
 // neighbours, to an eighth of a texel, and the far side of a strip narrower
 // than a texel exactly).
 // bary: the fragment's barycentrics; baryDx, baryDy: their steps per texel
-// (dFdx, dFdy).
+// (dFdx, dFdy). A CURVED_TEXEL_EXACT texel's triangles decide instead.
 bool offChart(vec3 bary, vec3 baryDx, vec3 baryDy, uint flags, uvec3 footprint, vec2 offset) {
+#ifdef CURVED_FOOTPRINT
+    if (exactFootprint != NO_EXACT_FOOTPRINT) return exactOffChart(exactFootprint, offset);
+#endif
     uint borders = (flags / TRIANGLE_CHART_BORDER0) & 7u;
     vec3 b = bary + baryDx * offset.x + baryDy * offset.y;
     return ((borders & 1u) != 0u && b.x < 0.0) || ((borders & 2u) != 0u && b.y < 0.0) ||

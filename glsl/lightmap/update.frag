@@ -345,7 +345,10 @@ bool curvedSample(out TexelSample s) {
     if (gl_HelperInvocation || !curvedFragmentIndex(vCurved)) return false;
     uvec4 head = curvedTexels[vCurved];
     ivec3 texel = curvedTexelTexel(head);
-    if (curvedTexelIsFlat(head)) return planeSample(curvedFlatFrame(vCurved), texel, curvedTexelCentre(vCurved), s);
+    if (curvedTexelIsFlat(head)) {
+        useFootprintOf(vCurved);
+        return planeSample(curvedFlatFrame(vCurved), texel, curvedTexelCentre(vCurved), s);
+    }
     s.texel = texel;
     // the leaf of the texel's centre takes its sample, as on flat texels
     if (!leafOwns(rootFromBundle(bundleFromWorld(curvedTexelCentre(vCurved)).xy))) return false;

@@ -33,6 +33,10 @@
 // top bit, a partial texel whose chart is flat over its square (CurvedTexel::flat):
 // sampled along its owner's plane, as the raster's texels are.
 #define CURVED_TEXEL_FLAT 0x80000000u
+// ... and in the next bit, a flat one whose footprint the owner's border edges,
+// the cells and one more edge do not hold (TexelFootprint::inexact): its points
+// are kept where one of its triangles holds them (CurvedTexel::exact).
+#define CURVED_TEXEL_EXACT 0x40000000u
 
 // SSBO binding of BakeTriangle triangles[] (lib/bake_vertex.glsl), bound in
 // chunks by MeshChunks (engine/layout/bake_mesh_gl.h)
