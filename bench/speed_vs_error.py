@@ -236,6 +236,21 @@ def make_street_canyon():
 # (issue 11: the error shown falling below 1 % by then); the spp sweeps cover
 # about the same times.
 DIRECTIONS = [16, 32, 64, 128, 256, 512, 1024, 2048, 4096]
+
+
+def city_sky(uv_layout):
+    """The bench city under a uniform sky, its light-map UVs by `uv_layout`."""
+    return {
+        "path": CITY_PATH,
+        "make": lambda: city(*CITY),
+        "flags": ["--uv-layout", uv_layout, "--resolution", "256", "--sky", "1,1,1"],
+        "directions": DIRECTIONS,
+        "spp": [4, 16, 64, 256, 1024, 4096],
+        "reference_flags": [],
+        "converged_spp": 16384,
+    }
+
+
 SCENES = {
     # converged_spp: the reference's own noise (summary.md) at most ~0.3 %, well
     # under the 1 % goal it measures (at 32768 spp the Cornell box's was 0.44 %
@@ -275,28 +290,12 @@ SCENES = {
     },
     # the city's nodes carry their texel densities (extras.texelDensity), so the
     # resolution only has to hold it on one page
-    "city_sky": {
-        "path": CITY_PATH,
-        "make": lambda: city(*CITY),
-        "flags": ["--uv-layout", "pack", "--resolution", "256", "--sky", "1,1,1"],
-        "directions": DIRECTIONS,
-        "spp": [4, 16, 64, 256, 1024, 4096],
-        "reference_flags": [],
-        "converged_spp": 16384,
-    },
+    "city_sky": city_sky("pack"),
     # the same city with light-map UVs made for it (charts 2 texels apart): the
     # generated city's own TEXCOORD_1 packs its sills, ledges and soffits closer
     # than a texel at this density (5286 of its 16442 texels hold two charts or
     # more, 71 % of city_sky's squared error at 1024 directions: design notes)
-    "city_sky_generate": {
-        "path": CITY_PATH,
-        "make": lambda: city(*CITY),
-        "flags": ["--uv-layout", "generate", "--resolution", "256", "--sky", "1,1,1"],
-        "directions": DIRECTIONS,
-        "spp": [4, 16, 64, 256, 1024, 4096],
-        "reference_flags": [],
-        "converged_spp": 16384,
-    },
+    "city_sky_generate": city_sky("generate"),
     "city_lid": {
         "path": LID_PATH,
         "make": make_city_lid,

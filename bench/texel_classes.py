@@ -15,6 +15,7 @@ has the same sign in both and is largest. Reads the EXRs and coverage PNGs
 through `oiiotool --dumpdata` (Debian openimageio-tools).
 """
 import collections
+import os
 import re
 import subprocess
 import sys
@@ -36,7 +37,7 @@ def load(path):
 
 def pages(directory):
     p = 0
-    while subprocess.run(["test", "-f", f"{directory}/lightmap_{p}.exr"]).returncode == 0:
+    while os.path.exists(f"{directory}/lightmap_{p}.exr"):
         p += 1
     return p
 

@@ -366,9 +366,7 @@ void Baker::Impl::coveragePass() {
         std::vector<uint8_t> partial;
         const std::vector<int32_t> owners = texelOwners(mesh, p, res, &partial);
         const std::vector<TexelFootprint> footprints = texelFootprints(mesh, p, res, owners, charts);
-        std::vector<uint8_t> inexact(footprints.size());
-        for (size_t i = 0; i < inexact.size(); ++i) inexact[i] = footprints[i].inexact;
-        curved[size_t(p)] = curvedTexels(mesh, p, res, owners, charts, partial, 0.02, inexact);
+        curved[size_t(p)] = curvedTexels(mesh, p, res, owners, charts, partial, footprints);
         std::erase_if(curved[size_t(p)], [&](const CurvedTexel& c) {
             if (codes[c.texel] != DILATION_SELF) return true;
             curvedRefs += int64_t(c.triangles.size());

@@ -434,7 +434,7 @@ bool texelAffine(const BakeMesh& mesh, uint32_t t, int res, bool normals, TexelA
 
 std::vector<CurvedTexel> curvedTexels(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,
                                       const std::vector<uint32_t>& chart, const std::vector<uint8_t>& partial,
-                                      double departure, const std::vector<uint8_t>& inexact) {
+                                      const std::vector<TexelFootprint>& footprints, double departure) {
     // every triangle of a covered texel's chart overlapping its square with
     // area, and how far it leaves the owner's plane there (at the corners of
     // its piece of the square), in the owner's texel sizes
@@ -476,7 +476,7 @@ std::vector<CurvedTexel> curvedTexels(const BakeMesh& mesh, int page, int res, c
         for (end = begin; end < overlaps.size() && overlaps[end].texel == i; ++end)
             worst = std::max(worst, overlaps[end].departure);
         const bool isPartial = !partial.empty() && partial[i];
-        const bool isInexact = !inexact.empty() && inexact[i];
+        const bool isInexact = !footprints.empty() && footprints[i].inexact;
         if (!(worst > departure) && !isPartial && !isInexact) continue;
         CurvedTexel texel{i, {o}, !(worst > departure), isInexact && !(worst > departure)};
         for (size_t k = begin; k < end; ++k)

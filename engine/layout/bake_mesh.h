@@ -159,11 +159,11 @@ struct CurvedTexel {
 // departures measured in the owner's texel size (the longer of its per-texel
 // steps along x and y). Every partial texel (`partial`, texelOwners' flags;
 // empty: none) is one, flat where it does not depart; so is every texel whose
-// flat footprint test is inexact (`inexact`, texelFootprints'; empty: none),
+// flat footprint test is inexact (`footprints`, texelFootprints'; empty: none),
 // with `exact` set.
 std::vector<CurvedTexel> curvedTexels(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,
                                       const std::vector<uint32_t>& chart, const std::vector<uint8_t>& partial = {},
-                                      double departure = 0.02, const std::vector<uint8_t>& inexact = {});
+                                      const std::vector<TexelFootprint>& footprints = {}, double departure = 0.02);
 
 // Triangle t's position (normal) as an affine function of page texel
 // coordinates: at(q) = at0 + dx * (q.x - q0.x) + dy * (q.y - q0.y). False where
