@@ -10,6 +10,7 @@
 #include <numeric>
 
 #include "bake/baker_impl.h"
+#include "bake/supersample.h"
 #include "bake/directions.h"
 #include "core/check.h"
 #include "core/log.h"
@@ -302,7 +303,7 @@ void Baker::Impl::uploadPartialPoints() {
     std::vector<BakeVertex> points;
     for (int p = 0; p < layout.pageCount; ++p) {
         std::vector<uint8_t> partial;
-        const std::vector<int32_t> owners = texelOwners(mesh, p, res, &partial);
+        const std::vector<int32_t> owners = texelOwners(mesh, p, res, &partial, minPartialArea());
         std::vector<std::pair<uint32_t, BakeVertex>> page;  // (material, point)
         for (size_t i = 0; i < owners.size(); ++i) {
             if (!partial[i]) continue;
@@ -364,7 +365,7 @@ void Baker::Impl::coveragePass() {
     for (int p = 0; p < layout.pageCount; ++p) {
         gl::readTexture(dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, codes.data());
         std::vector<uint8_t> partial;
-        const std::vector<int32_t> owners = texelOwners(mesh, p, res, &partial);
+        const std::vector<int32_t> owners = texelOwners(mesh, p, res, &partial, minPartialArea());
         const std::vector<TexelFootprint> footprints = texelFootprints(mesh, p, res, owners, charts);
         curved[size_t(p)] = curvedTexels(mesh, p, res, owners, charts, partial, footprints);
         std::erase_if(curved[size_t(p)], [&](const CurvedTexel& c) {
@@ -769,9 +770,12 @@ Baker::~Baker() = default;
 
 Expected<std::unique_ptr<Baker>> Baker::create(const Scene& scene, const Layout& layout, const BakeOptions& options) {
     auto impl = std::make_unique<Impl>();
+    if (options.supersample != 1 && options.supersample != 2)
+        return Status::error("supersample must be 1 or 2, not " + std::to_string(options.supersample));
     impl->options = options;
-    impl->layout = layout;
-    impl->mesh = buildBakeMesh(scene, layout);
+    impl->outputLayout = layout;
+    impl->layout = options.supersample > 1 ? supersampledLayout(layout, options.supersample) : layout;
+    impl->mesh = buildBakeMesh(scene, impl->layout);
     MemoryTracker::gpu().resetPeak();
     Status s = impl->init(scene);
     if (!s) return s;
@@ -852,6 +856,7 @@ LightmapPages Baker::readLightmaps() {
         out.area.push_back(std::move(area));
     }
     m.noteMemory();
+    if (m.options.supersample > 1) return reduceLightmaps(out, m.mesh, m.outputLayout);
     return out;
 }
 

@@ -25,7 +25,8 @@ struct Baker::Impl {
     BakeOptions options;
     BakeMesh mesh;
     std::vector<uint32_t> charts;  // per triangle, its light map chart (findLightmapCharts; uploadMesh)
-    Layout layout;
+    Layout layout;        // what the bake runs on: outputLayout, or its supersampled one
+    Layout outputLayout;  // the caller's: readLightmaps reduces to it (bake/supersample.h)
     std::vector<Material> materials;
     std::vector<DirectionalLight> lights;
     std::vector<PunctualLight> punctualLights;  // point and spot (direct_light.cpp)
@@ -71,6 +72,8 @@ struct Baker::Impl {
     // p + backLayerOffset (13 more bytes a texel; the direct light stays front-only).
     gl::Texture accum, radiance, direct, dilation, chartNeighbours, readModes, footprint, texelCharts;
     int backLayerOffset = 0;  // 0: no double-sided triangles, one layer per page
+    // texelOwners' threshold for partial texels: a quarter of it for half-size texels (bake/supersample.h)
+    double minPartialArea() const { return kMinPartialTexelArea / double(options.supersample * options.supersample); }
     int stateLayers() const { return layout.pageCount + backLayerOffset; }  // accum's and radiance's layers
     // The bundle and update programs handle back sides only when built with it:
     // llvmpipe runs even a uniformly skipped branch's texture fetch (25 % of the bundle pass)

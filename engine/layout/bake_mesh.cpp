@@ -142,7 +142,8 @@ double pageCorners(const BakeMesh& mesh, uint32_t t, int res, glm::dvec2 (&q)[3]
     return std::fabs(area2);
 }
 
-std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res, std::vector<uint8_t>* partial) {
+std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res, std::vector<uint8_t>* partial,
+                                 double minPartialArea) {
     CHECK(mesh.triangles.size() <= size_t(INT32_MAX));
     std::vector<int32_t> owner(size_t(res) * res, -1);
     const std::vector<uint32_t> order = pageDrawOrder(mesh, page);
@@ -178,7 +179,7 @@ std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res, std::v
             }
     }
     // texels no centre owns: the triangle holding the most of the square, where
-    // the triangles hold kMinPartialTexelArea of it in all
+    // the triangles hold minPartialArea of it in all
     std::vector<double> best(owner.size(), 0.0), total(owner.size(), 0.0);
     std::vector<uint8_t> isPartial(owner.size(), 0);
     for (uint32_t t : order) {
@@ -197,7 +198,7 @@ std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res, std::v
         });
     }
     for (size_t i = 0; i < owner.size(); ++i)
-        if (isPartial[i] && !(total[i] >= kMinPartialTexelArea)) {
+        if (isPartial[i] && !(total[i] >= minPartialArea)) {
             owner[i] = -1;
             isPartial[i] = 0;
         }
@@ -393,11 +394,15 @@ std::vector<TexelFootprint> texelFootprints(const BakeMesh& mesh, int page, int 
             wrong += taken != bool(exact[size_t(k)]);
         }
         out[i].inexact = wrong > kInexactFootprintShare * on;
+        for (int k = 0; k < N * N; ++k) out[i].quarters[size_t((k % N) * 2 / N + (k / N) * 2 / N * 2)] += exact[size_t(k)];
         if (out[i].inexact) out[i].area = uint8_t(std::lround(255.0 * on / (N * N)));
     }
     for (size_t i = 0; i < mask.size(); ++i) {
         out[i].cells = mask[i];
-        if (owner[i] >= 0 && mask[i] == ~uint64_t(0)) out[i].area = 255;
+        if (owner[i] >= 0 && mask[i] == ~uint64_t(0)) {
+            out[i].area = 255;
+            out[i].quarters.fill(N * N / 4);
+        }
     }
     return out;
 }

@@ -7,6 +7,7 @@
 // as-is into a vertex buffer.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -83,8 +84,12 @@ double pageCorners(const BakeMesh& mesh, uint32_t t, int res, glm::dvec2 (&q)[3]
 // padding: a bundle pixel's centre crosses them in too few directions
 // (update.frag footprintPixel), and a sliver a sixtieth of its square read
 // 20 % noise at 2048 directions where its neighbours read 1 %.
+// A supersampled bake (bake/supersample.h) takes a quarter of that: the half-
+// size texels of a strip a fifth of a texel wide along a texel's centre line
+// hold a fifth of their square each, and the texel they make must have them.
 constexpr double kMinPartialTexelArea = 0.25;
-std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res, std::vector<uint8_t>* partial = nullptr);
+std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res, std::vector<uint8_t>* partial = nullptr,
+                                 double minPartialArea = kMinPartialTexelArea);
 
 // Which parts of each texel's square lie on its chart (the chart of its owner,
 // texelOwners): bit 8 j + i for the cell [i/8, (i+1)/8) x [j/8, (j+1)/8) of the
@@ -119,6 +124,11 @@ struct TexelFootprint {
     // (curvedTexels, CurvedTexel::exact) and keeps the points one of its
     // triangles holds; `area` is then that part's (the grid's count).
     bool inexact = false;
+    // Points of the 32 x 32 grid on the chart in each quarter of the square
+    // (0..256; (x, y) = (0, 0), (1, 0), (0, 1), (1, 1) at index x + 2 y, y up
+    // the page): how much each of its 2 x 2 texels in a supersampled bake
+    // weighs in it (bake/supersample.h).
+    std::array<uint16_t, 4> quarters{};
 };
 constexpr double kInexactFootprintShare = 0.1;
 std::vector<TexelFootprint> texelFootprints(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,

@@ -2,6 +2,7 @@
 // See reference_baker.h for the model and the sampling; the notes here are
 // about how.
 #include "reference/reference_baker.h"
+#include "bake/supersample.h"
 #include "scene/punctual_light.h"
 
 #include <algorithm>
@@ -814,31 +815,10 @@ LightmapPages ReferenceBaker::readLightmaps() const {
     for (size_t i = 0; i < m.texels.size(); ++i)
         maps[m.texels[i].page][m.texels[i].index] = glm::vec4(glm::vec3(m.sums[i] * scale), 1.0f);
     // dilation: an empty texel takes the mean of its filled 8-neighbours, padding + 1 times
-    const int passes = m.layout.padding + 1;
     for (auto& map : maps) {
         std::vector<uint8_t> cov(perPage);
         for (size_t i = 0; i < perPage; ++i) cov[i] = map[i].w > 0.0f;
-        for (int pass = 0; pass < passes; ++pass) {
-            std::vector<glm::vec4> next = map;
-            for (int y = 0; y < res; ++y)
-                for (int x = 0; x < res; ++x) {
-                    if (map[size_t(y) * res + x].w > 0.0f) continue;
-                    glm::vec3 sum(0.0f);
-                    float count = 0.0f;
-                    for (int dy = -1; dy <= 1; ++dy)
-                        for (int dx = -1; dx <= 1; ++dx) {
-                            int qx = x + dx, qy = y + dy;
-                            if (qx < 0 || qy < 0 || qx >= res || qy >= res) continue;
-                            const glm::vec4& s = map[size_t(qy) * res + qx];
-                            if (s.w > 0.0f) {
-                                sum += glm::vec3(s);
-                                count += 1.0f;
-                            }
-                        }
-                    if (count > 0.0f) next[size_t(y) * res + x] = glm::vec4(sum / count, 1.0f);
-                }
-            map.swap(next);
-        }
+        dilate(map, res, m.layout.padding + 1);
         io::ImageRgb img;
         img.width = img.height = res;
         img.pixels.resize(perPage);

@@ -1,0 +1,85 @@
+#include "bake/supersample.h"
+
+namespace bb {
+
+Layout supersampledLayout(const Layout& layout, int k) {
+    Layout out = layout;
+    out.resolution *= k;
+    out.padding *= k;
+    out.texelDensity *= float(k);
+    for (InstanceRect& r : out.rects) {
+        r.x *= k;
+        r.y *= k;
+        r.width *= k;
+        r.height *= k;
+        r.texelDensity *= float(k);
+    }
+    return out;
+}
+
+LightmapPages reduceLightmaps(const LightmapPages& fine, const BakeMesh& mesh, const Layout& layout) {
+    const int res = layout.resolution, fineRes = fine.resolution;
+    const size_t perPage = size_t(res) * res;
+    const std::vector<uint32_t> charts = findLightmapCharts(mesh);
+    LightmapPages out;
+    out.resolution = res;
+    for (int p = 0; p < layout.pageCount; ++p) {
+        const std::vector<int32_t> owner = texelOwners(mesh, p, res);
+        const std::vector<TexelFootprint> footprints = texelFootprints(mesh, p, res, owner, charts);
+        const io::ImageRgb& from = fine.pages[size_t(p)];
+        std::vector<glm::vec4> map(perPage, glm::vec4(0.0f));
+        std::vector<uint8_t> covered(perPage), area(perPage);
+        for (size_t i = 0; i < perPage; ++i) {
+            const TexelFootprint& f = footprints[i];
+            const int x = int(i % size_t(res)), y = int(i / size_t(res));
+            glm::dvec3 sum(0.0);
+            double weight = 0.0;
+            bool baked = false;  // one of its half-size texels was (not only dilated)
+            for (int q = 0; q < 4; ++q) {
+                const size_t j = size_t(2 * y + q / 2) * size_t(fineRes) + size_t(2 * x + q % 2);
+                sum += glm::dvec3(from.pixels[j]) * double(f.quarters[size_t(q)]);
+                weight += f.quarters[size_t(q)];
+                baked |= f.quarters[size_t(q)] > 0 && fine.covered[size_t(p)][j];
+            }
+            if (owner[i] < 0 || !baked) continue;
+            map[i] = glm::vec4(glm::vec3(sum / weight), 1.0f);
+            covered[i] = 1;
+            area[i] = f.area;
+        }
+        dilate(map, res, layout.padding + 1);
+        io::ImageRgb img;
+        img.width = img.height = res;
+        img.pixels.resize(perPage);
+        for (size_t i = 0; i < perPage; ++i) img.pixels[i] = glm::vec3(map[i]);
+        out.pages.push_back(std::move(img));
+        out.covered.push_back(std::move(covered));
+        out.area.push_back(std::move(area));
+    }
+    return out;
+}
+
+void dilate(std::vector<glm::vec4>& map, int res, int passes) {
+    for (int pass = 0; pass < passes; ++pass) {
+        std::vector<glm::vec4> next = map;
+        for (int y = 0; y < res; ++y)
+            for (int x = 0; x < res; ++x) {
+                if (map[size_t(y) * res + x].w > 0.0f) continue;
+                glm::vec3 sum(0.0f);
+                float count = 0.0f;
+                for (int dy = -1; dy <= 1; ++dy)
+                    for (int dx = -1; dx <= 1; ++dx) {
+                        const int qx = x + dx, qy = y + dy;
+                        if (qx < 0 || qy < 0 || qx >= res || qy >= res) continue;
+                        const glm::vec4& s = map[size_t(qy) * res + qx];
+                        if (s.w > 0.0f) {
+                            sum += glm::vec3(s);
+                            count += 1.0f;
+                        }
+                    }
+                if (count > 0.0f) next[size_t(y) * res + x] = glm::vec4(sum / count, 1.0f);
+            }
+        map.swap(next);
+    }
+}
+
+}  // namespace bb
