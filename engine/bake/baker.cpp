@@ -129,7 +129,9 @@ nlohmann::json BakeStats::toJson() const {
                    {"node_buffer_bytes", nodeBufferBytes}, {"head_image_bytes", headImageBytes}, {"bytes_per_node", 12}};
     j["lightmap"] = {{"texels", lightmapTexels}, {"covered_texels", coveredTexels}, {"shared_texels", sharedTexels},
                    {"curved_texels", curvedTexels}, {"partial_texels", partialTexels},
-                   {"exact_footprint_texels", exactFootprintTexels}};
+                   {"exact_footprint_texels", exactFootprintTexels}, {"supersample", supersample},
+                   {"supersample_filled_texels", supersampleFilledTexels},
+                   {"supersample_lost_texels", supersampleLostTexels}};
     j["direct_light"] = {{"explicit_emitters", explicitEmitters}, {"emitter_samples", emitterSampleCount}};
     double bundleSeconds = secondsBundle > 0 ? secondsBundle : 1e-9;
     double updateSeconds = secondsUpdate > 0 ? secondsUpdate : 1e-9;
@@ -633,11 +635,12 @@ Status Baker::Impl::init(const Scene& scene) {
     {
         // the noise estimate's half: about 256^2 sampled texels a page, every texel of small pages
         MemoryCategory category("noise estimate");
-        stats.noiseStride = std::clamp(int(std::bit_floor(unsigned(std::max(1, res / 256)))), 1, 16);
-        halfWidth = (res + stats.noiseStride - 1) / stats.noiseStride;
+        const int outputRes = outputLayout.resolution, k = options.supersample;
+        stats.noiseStride = std::clamp(int(std::bit_floor(unsigned(std::max(1, outputRes / 256)))), 1, 16);
+        halfWidth = (outputRes + stats.noiseStride - 1) / stats.noiseStride * k;
         halfAccum = gl::Texture::create2DArray("noise estimate: odd directions' accumulators", GL_RG32UI, halfWidth,
                                                halfWidth, pages);
-        noiseTerms = gl::Texture::create2DArray("noise estimate terms", GL_RGBA32F, halfWidth, halfWidth, pages);
+        noiseTerms = gl::Texture::create2DArray("noise estimate terms", GL_RGBA32F, halfWidth / k, halfWidth / k, pages);
     }
     const uint32_t zero[4] = {0, 0, 0, 0};
     clearAccumulators();
@@ -770,11 +773,16 @@ Baker::~Baker() = default;
 
 Expected<std::unique_ptr<Baker>> Baker::create(const Scene& scene, const Layout& layout, const BakeOptions& options) {
     auto impl = std::make_unique<Impl>();
-    if (options.supersample != 1 && options.supersample != 2)
-        return Status::error("supersample must be 1 or 2, not " + std::to_string(options.supersample));
+    if (options.supersample < 0 || options.supersample > 2)
+        return Status::error("supersample must be 0 (auto), 1 or 2, not " + std::to_string(options.supersample));
     impl->options = options;
+    int& k = impl->options.supersample;
+    constexpr int64_t kMaxStateBytesPerTexel = 46;  // light-map state with double-sided materials
+    if (k == 0)
+        k = int64_t(layout.texelCount()) * 4 * kMaxStateBytesPerTexel <= options.memoryBudget / 2 && layout.resolution <= 8192 ? 2 : 1;
+    impl->stats.supersample = k;
     impl->outputLayout = layout;
-    impl->layout = options.supersample > 1 ? supersampledLayout(layout, options.supersample) : layout;
+    impl->layout = k > 1 ? supersampledLayout(layout, k) : layout;
     impl->mesh = buildBakeMesh(scene, impl->layout);
     MemoryTracker::gpu().resetPeak();
     Status s = impl->init(scene);
@@ -856,8 +864,14 @@ LightmapPages Baker::readLightmaps() {
         out.area.push_back(std::move(area));
     }
     m.noteMemory();
-    if (m.options.supersample > 1) return reduceLightmaps(out, m.mesh, m.outputLayout);
-    return out;
+    if (m.options.supersample == 1) return out;
+    LightmapPages reduced = reduceLightmaps(out, m.mesh, m.outputLayout);
+    if (reduced.lostTexels > 0 && m.stats.supersampleLostTexels == 0)
+        logWarning(std::to_string(reduced.lostTexels) + " covered light map texels hold no half-size texel of their chart, nor "
+                   "a neighbour on it (charts packed tighter than a texel?): left as padding; --supersample 1 bakes them");
+    m.stats.supersampleFilledTexels = reduced.filledTexels;
+    m.stats.supersampleLostTexels = reduced.lostTexels;
+    return reduced;
 }
 
 std::vector<std::vector<glm::vec4>> Baker::readAccumulators() {

@@ -91,7 +91,9 @@ struct BakeOptions {
     // 2: bake every light map texel as 2 x 2 half-size ones and reduce them to
     // it, each weighted by its part of the texel's footprint (bake/supersample.h):
     // the bounced light is read at twice the resolution. 4x the texels and
-    // light-map state, about 2x the time. 1: texels as laid out.
+    // light-map state, about 2x the time. 1: texels as laid out. 0: 2 when
+    // the light-map state at 4x the texels (46 bytes each at most) takes at
+    // most half the memory budget, else 1 (BakeStats::supersample says which).
     int supersample = 1;
 };
 
@@ -122,6 +124,12 @@ struct BakeStats {
                                // and partial texels (texelOwners), which are drawn as curved ones
     int64_t partialTexels = 0;      // covered texels whose centre is on no chart (layout/bake_mesh.h texelOwners)
     int64_t exactFootprintTexels = 0;  // flat ones among the curved whose points their triangles keep (CurvedTexel::exact)
+    // supersampled bakes (BakeOptions::supersample; the texel counts above are
+    // the half-size ones): texels of the layout filled from their neighbours by the last
+    // readLightmaps (LightmapPages::filledTexels)
+    int64_t supersampleFilledTexels = 0;
+    int64_t supersampleLostTexels = 0;  // left as padding (no neighbour on their chart either)
+    int supersample = 1;  // half-size texels a texel across (BakeOptions::supersample, auto resolved)
     int64_t curvedTexelBytes = 0;   // their records (bake/curved_footprints.h), part of lightmapStateBytes
     std::vector<double> predictedOverActual;  // per tile: predicted nodes / actual nodes
     std::vector<int> tilesPerDirection;
@@ -183,6 +191,9 @@ struct LightmapPages {
     // (layout/bake_mesh.h texelFootprints: what the bake's samples cover);
     // empty: whole squares (the reference's maps, maps read from files)
     std::vector<std::vector<uint8_t>> area;
+    // covered texels a supersampled bake's reduction filled from their neighbours (bake/supersample.h)
+    int64_t filledTexels = 0;
+    int64_t lostTexels = 0;  // and those left as padding: no neighbour on their chart either
 };
 
 class Baker {

@@ -87,7 +87,16 @@ struct Baker::Impl {
     // noiseStride-th texel (8 bytes / stride^2 a page texel; its own memory category)
     gl::Texture halfAccum;
     gl::Texture noiseTerms;  // noise.comp's per-texel terms (RGBA32F, halfAccum's size)
-    int halfWidth = 1;     // halfAccum's side: ceil(resolution / stride)
+    // halfAccum's side: ceil(output resolution / stride) x supersample. It keeps
+    // every stride-th texel of the output layout's, all its half-size texels
+    // (update.frag): the estimate is the reduced map's (noise.comp).
+    int halfWidth = 1;
+    // texel (x, y)'s place in halfAccum's page, or -1 if it is not sampled
+    int64_t halfTexel(int x, int y) const {
+        const int k = options.supersample, stride = stats.noiseStride;
+        if ((x / k) % stride != 0 || (y / k) % stride != 0) return -1;
+        return int64_t(y / k / stride * k + y % k) * halfWidth + (x / k / stride * k + x % k);
+    }
     gl::Texture envTexture;
     gl::Framebuffer pageFbo;
     gl::Program updateProgram, sunProgram, updateCurvedProgram, sunCurvedProgram, resolveProgram, rescaleProgram, metaProgram, coverageProgram,

@@ -48,17 +48,19 @@ double Baker::Impl::noiseHalvesFactor() const {
 void Baker::Impl::estimateNoise() {
     gl::DebugGroup group("noise estimate");
     glUseProgram(noiseProgram.id());
+    const int width = halfWidth / options.supersample;  // sampled texels of the output layout a side
     glUniform1i(noiseProgram.uniform("halfStride"), stats.noiseStride);
+    glUniform1i(noiseProgram.uniform("supersample"), options.supersample);
     glUniform1i(noiseProgram.uniform("pageCount"), layout.pageCount);
-    glUniform2i(noiseProgram.uniform("pageSize"), halfWidth, halfWidth);
+    glUniform2i(noiseProgram.uniform("pageSize"), width, width);
     glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RG32UI);
     glBindImageTexture(BINDING_HALF_ACCUM, halfAccum.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RG32UI);
     glBindImageTexture(BINDING_DIRECT, direct.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
     glBindImageTexture(BINDING_TARGET, noiseTerms.id(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glDispatchCompute(GLuint(halfWidth + 7) / 8, GLuint(halfWidth + 7) / 8, GLuint(layout.pageCount));
+    glDispatchCompute(GLuint(width + 7) / 8, GLuint(width + 7) / 8, GLuint(layout.pageCount));
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
-    std::vector<glm::vec4> values(size_t(halfWidth) * halfWidth * size_t(layout.pageCount));
-    gl::readTexture(noiseTerms.id(), 0, 0, 0, halfWidth, halfWidth, layout.pageCount, GL_RGBA, GL_FLOAT, 16, values.data());
+    std::vector<glm::vec4> values(size_t(width) * width * size_t(layout.pageCount));
+    gl::readTexture(noiseTerms.id(), 0, 0, 0, width, width, layout.pageCount, GL_RGBA, GL_FLOAT, 16, values.data());
     double variance = 0, sum = 0;
     int64_t texels = 0;
     for (const glm::vec4& v : values) {

@@ -45,6 +45,7 @@ void Baker::Impl::beginDirection(int k) {
             // two independently rotated sets (bake/directions.h)
             glUniform1i(program->uniform("oddDirection"), k % 2);
             glUniform1i(program->uniform("halfStride"), stats.noiseStride);
+            glUniform1i(program->uniform("supersample"), options.supersample);
             glUniform1i(program->uniform("backLayerOffset"), backLayerOffset);
             glUniform1f(program->uniform("depthBias"), depthBias);
             glUniform1ui(program->uniform("footprintSample"), uint32_t(k));
@@ -106,15 +107,14 @@ void Baker::Impl::combineShares(int round) {
         std::vector<uint8_t> codes(size_t(res) * res);
         coveredTexelIndex.resize(size_t(layout.pageCount));
         halfCoveredTexelIndex.resize(size_t(layout.pageCount));
-        const int stride = stats.noiseStride;
         for (int p = 0; p < layout.pageCount; ++p) {
             gl::readTexture(dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, codes.data());
             for (int y = 0; y < res; ++y)
                 for (int x = 0; x < res; ++x) {
                     if (codes[size_t(y) * res + x] != DILATION_SELF) continue;
                     coveredTexelIndex[size_t(p)].push_back(uint32_t(y * res + x));
-                    if (x % stride == 0 && y % stride == 0)
-                        halfCoveredTexelIndex[size_t(p)].push_back(uint32_t(y / stride * halfWidth + x / stride));
+                    if (const int64_t half = halfTexel(x, y); half >= 0)
+                        halfCoveredTexelIndex[size_t(p)].push_back(uint32_t(half));
                 }
         }
     }

@@ -23,29 +23,59 @@ LightmapPages reduceLightmaps(const LightmapPages& fine, const BakeMesh& mesh, c
     const std::vector<uint32_t> charts = findLightmapCharts(mesh);
     LightmapPages out;
     out.resolution = res;
+    std::vector<std::pair<size_t, glm::vec4>> fill;
     for (int p = 0; p < layout.pageCount; ++p) {
         const std::vector<int32_t> owner = texelOwners(mesh, p, res);
         const std::vector<TexelFootprint> footprints = texelFootprints(mesh, p, res, owner, charts);
+        const std::vector<int32_t> fineOwner = texelOwners(mesh, p, fineRes, nullptr, kMinPartialTexelArea / 4.0);
         const io::ImageRgb& from = fine.pages[size_t(p)];
         std::vector<glm::vec4> map(perPage, glm::vec4(0.0f));
         std::vector<uint8_t> covered(perPage), area(perPage);
         for (size_t i = 0; i < perPage; ++i) {
             const TexelFootprint& f = footprints[i];
             const int x = int(i % size_t(res)), y = int(i / size_t(res));
+            if (owner[i] < 0) continue;
             glm::dvec3 sum(0.0);
             double weight = 0.0;
-            bool baked = false;  // one of its half-size texels was (not only dilated)
             for (int q = 0; q < 4; ++q) {
                 const size_t j = size_t(2 * y + q / 2) * size_t(fineRes) + size_t(2 * x + q % 2);
+                if (!fine.covered[size_t(p)][j] || fineOwner[j] < 0 || charts[size_t(fineOwner[j])] != charts[size_t(owner[i])])
+                    continue;
                 sum += glm::dvec3(from.pixels[j]) * double(f.quarters[size_t(q)]);
                 weight += f.quarters[size_t(q)];
-                baked |= f.quarters[size_t(q)] > 0 && fine.covered[size_t(p)][j];
             }
-            if (owner[i] < 0 || !baked) continue;
-            map[i] = glm::vec4(glm::vec3(sum / weight), 1.0f);
             covered[i] = 1;
             area[i] = f.area;
+            if (weight > 0.0) map[i] = glm::vec4(glm::vec3(sum / weight), 1.0f);
         }
+        // texels with no half-size texel of their own: their chart's neighbours' mean, else padding
+        for (size_t i = 0; i < perPage; ++i) {
+            if (!covered[i] || map[i].w > 0.0f) continue;
+            const int x = int(i % size_t(res)), y = int(i / size_t(res));
+            glm::vec3 sum(0.0f);
+            float n = 0.0f;
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                    const int qx = x + dx, qy = y + dy;
+                    if (qx < 0 || qy < 0 || qx >= res || qy >= res) continue;
+                    const size_t j = size_t(qy) * size_t(res) + size_t(qx);
+                    if (map[j].w > 0.0f && covered[j] && charts[size_t(owner[j])] == charts[size_t(owner[i])]) {
+                        sum += glm::vec3(map[j]);
+                        n += 1.0f;
+                    }
+                }
+            if (n == 0.0f) continue;
+            fill.push_back({i, glm::vec4(sum / n, 1.0f)});
+            ++out.filledTexels;
+        }
+        for (const auto& [i, value] : fill) map[i] = value;
+        for (size_t i = 0; i < perPage; ++i)
+            if (covered[i] && map[i].w == 0.0f) {
+                covered[i] = 0;
+                area[i] = 0;
+                ++out.lostTexels;
+            }
+        fill.clear();
         dilate(map, res, layout.padding + 1);
         io::ImageRgb img;
         img.width = img.height = res;

@@ -5,7 +5,10 @@
 // minus the odd: M_e = (M W - M_o W_o) / (W - W_o)). Writes (sum over RGB of
 // (M_e - M_o)^2, sum over RGB of L_lm, 1) for texels where both halves hold
 // samples, zeros elsewhere; the CPU sums and scales by the halves' weights
-// (noise.cpp noiseHalvesFactor).
+// (noise.cpp noiseHalvesFactor). A supersampled bake's texel is the mean of
+// its supersample^2 half-size texels (bake/supersample.h): M_e - M_o and L_lm
+// are those texels' means (equal weights; the reduction weighs them by their
+// parts of the footprint), over those where both halves hold samples.
 #include "shared/bundle_layout.h"
 #include "lib/rounding.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -15,22 +18,34 @@ layout(binding = BINDING_HALF_ACCUM, rg32ui) uniform readonly uimage2DArray half
 layout(binding = BINDING_DIRECT, rgba16f) uniform readonly image2DArray directMap;
 layout(binding = BINDING_TARGET, rgba32f) uniform writeonly image2DArray target;
 uniform int halfStride;
+uniform int supersample;
 uniform int pageCount;
-uniform ivec2 pageSize;  // of halfAccum
+uniform ivec2 pageSize;  // sampled texels of the output layout a side (halfAccum's / supersample)
 
 void main() {
     ivec3 h = ivec3(gl_GlobalInvocationID.xy, gl_GlobalInvocationID.z);
     if (h.x >= pageSize.x || h.y >= pageSize.y || h.z >= pageCount) return;
-    vec4 whole = decodeAccumulator(imageLoad(accum, ivec3(h.xy * halfStride, h.z)).rg);
-    vec4 odd = decodeAccumulator(imageLoad(halfAccum, h).rg);
-    float evenWeight = whole.a - odd.a;
-    // both halves need weight; the whole's W rounds (7 bits), so ask for a margin
-    if (odd.a <= 0.0 || evenWeight <= 0.02 * whole.a) {
+    vec3 d = vec3(0.0), l = vec3(0.0);
+    float n = 0.0;
+    for (int j = 0; j < supersample; ++j)
+        for (int i = 0; i < supersample; ++i) {
+            ivec2 sub = ivec2(i, j);
+            ivec3 t = ivec3(h.xy * halfStride * supersample + sub, h.z);
+            vec4 whole = decodeAccumulator(imageLoad(accum, t).rg);
+            vec4 odd = decodeAccumulator(imageLoad(halfAccum, ivec3(h.xy * supersample + sub, h.z)).rg);
+            float evenWeight = whole.a - odd.a;
+            // both halves need weight; the whole's W rounds (7 bits), so ask for a margin
+            if (odd.a <= 0.0 || evenWeight <= 0.02 * whole.a) continue;
+            vec3 even = (whole.rgb * whole.a - odd.rgb * odd.a) / evenWeight;
+            d += even - odd.rgb;
+            l += whole.rgb + imageLoad(directMap, t).rgb;
+            n += 1.0;
+        }
+    if (n == 0.0) {
         imageStore(target, h, vec4(0.0));
         return;
     }
-    vec3 even = (whole.rgb * whole.a - odd.rgb * odd.a) / evenWeight;
-    vec3 d = even - odd.rgb;
-    vec3 l = whole.rgb + imageLoad(directMap, ivec3(h.xy * halfStride, h.z)).rgb;
+    d /= n;
+    l /= n;
     imageStore(target, h, vec4(dot(d, d), l.r + l.g + l.b, 1.0, 0.0));
 }

@@ -64,6 +64,7 @@ uniform uint randomSeed;
 layout(binding = BINDING_HALF_ACCUM, rg32ui) uniform coherent uimage2DArray halfAccum;
 uniform bool oddDirection;
 uniform int halfStride;
+uniform int supersample;  // half-size texels a light map texel across (bake/supersample.h): all of a sampled one's
 uniform int backLayerOffset;  // BACK_SIDES: double-sided triangles' back sides' accumulators at layer page + this
 #endif
 uniform uint nodeCount;      // nodes in this tile's lists (END_OF_LIST is larger)
@@ -507,8 +508,9 @@ void main() {
         imageStore(accum, back, uvec4(folded, 0u, 0u));
     }
 #endif
-    if (oddDirection && texel.x % halfStride == 0 && texel.y % halfStride == 0) {
-        ivec3 half_ = ivec3(texel.xy / halfStride, texel.z);
+    ivec2 outputTexel = texel.xy / supersample;
+    if (oddDirection && outputTexel.x % halfStride == 0 && outputTexel.y % halfStride == 0) {
+        ivec3 half_ = ivec3(outputTexel / halfStride * supersample + texel.xy % supersample, texel.z);
         imageStore(halfAccum, half_, uvec4(foldSample(imageLoad(halfAccum, half_).rg, incoming, w, pcgHash(h ^ 0x9e3779b9u)), 0u, 0u));
     }
 #endif

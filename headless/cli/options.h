@@ -49,7 +49,7 @@ struct BakeArgs {
     float historyPower = -1.0f;
     std::string direct = "auto";
     int emitterSamples = 0;
-    int supersample = 1;              // 1 | 2 (BakeOptions::supersample)
+    std::string supersample = "auto";  // auto | 1 | 2 (BakeOptions::supersample)
     std::string seams = "stitch";     // stitch | off (bake/seam_stitch.h)
     bool preview = true;
     bool progress = true;

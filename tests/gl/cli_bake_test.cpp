@@ -180,8 +180,12 @@ TEST(CliBake, SuccessWritesCompleteOutputsAndNoTempFiles) {
     EXPECT_GT(number("/memory/node_buffer_bytes"), 0.0);
     EXPECT_GT(number("/memory/head_image_bytes"), 0.0);
     EXPECT_GT(number("/memory/peak_gpu_bytes"), 0.0);
-    // light map texels
-    EXPECT_EQ(number("/lightmap/texels"), 16 * 16);
+    // light map texels: the bake's own, 2 x 2 a layout texel (--supersample
+    // auto: 2 while that light-map state takes at most half the budget)
+    EXPECT_EQ(number("/lightmap/supersample"), 2.0);
+    const double texels = 32 * 32;
+    EXPECT_EQ(number("/lightmap/texels"), texels);
+    EXPECT_EQ(number("/lightmap/supersample_filled_texels"), 0.0);
     EXPECT_GT(number("/lightmap/covered_texels"), 0.0);
     // fragments per second
     EXPECT_GT(number("/throughput/fragments"), 0.0);
@@ -195,9 +199,9 @@ TEST(CliBake, SuccessWritesCompleteOutputsAndNoTempFiles) {
     EXPECT_GE(number("/lightmap/curved_texels"), number("/lightmap/partial_texels"));
     const double curvedBytes = number("/memory/curved_texel_bytes");
     EXPECT_GT(curvedBytes, 0.0);
-    EXPECT_EQ(number("/memory/lightmap_state_bytes"), 37.0 * 16 * 16 + curvedBytes);
-    EXPECT_EQ(number("/memory/lightmap_bytes_per_page_texel"), 37.0 + curvedBytes / (16 * 16));
-    EXPECT_EQ(number("/memory/by_category/light maps/peak_bytes"), 37.0 * 16 * 16 + curvedBytes);
+    EXPECT_EQ(number("/memory/lightmap_state_bytes"), 37.0 * texels + curvedBytes);
+    EXPECT_EQ(number("/memory/lightmap_bytes_per_page_texel"), 37.0 + curvedBytes / texels);
+    EXPECT_EQ(number("/memory/by_category/light maps/peak_bytes"), 37.0 * texels + curvedBytes);
     EXPECT_GE(number("/memory/lightmap_bytes_per_covered_texel"), 37.0);
     // every category's peak is part of the whole's
     double sum = 0;

@@ -297,6 +297,7 @@ TEST(EnvironmentBake, CliEnvFileBakesAsInMemoryMap) {
     BakeOptions options;
     options.directions = 64;
     options.seed = 1;
+    options.supersample = 0;  // as the CLI's --supersample auto
     options.environment = env;
     auto inMemory = bakeGpu(*scene, *layout, options);
     ASSERT_TRUE(inMemory) << inMemory.error();

@@ -1,0 +1,91 @@
+// Supersampled bakes' reduction (bake/supersample.h): a texel of the layout
+// is the mean of its 2 x 2 half-size texels, each weighted by its quarter's
+// part of the texel's footprint, over those baked on the texel's own chart.
+#include <gtest/gtest.h>
+
+#include "bake/supersample.h"
+
+namespace bb {
+namespace {
+
+// Two charts on an 8 x 8 page (texel units): A over x 1..4.6, y 1..5, and B
+// over x 4.6..7, y 1..6 (its left edge's ends are not A's: another chart).
+// Texel (4, 2) is A's (its centre 4.5 is on A): 0.6 of its square, the left
+// quarters whole and a fifth of the right ones, whose half-size texels B owns.
+BakeMesh twoCharts() {
+    BakeMesh m;
+    auto quad = [&](glm::vec2 a, glm::vec2 b) {
+        const glm::vec2 p00 = a, p10(b.x, a.y), p11 = b, p01(a.x, b.y);
+        const std::pair<std::array<glm::vec2, 3>, uint32_t> tris[2] = {{{p00, p10, p11}, 1u | 4u},
+                                                                      {{p00, p11, p01}, 1u | 2u}};
+        for (const auto& [corners, borders] : tris) {
+            for (const glm::vec2& c : corners) {
+                BakeVertex v;
+                v.position = glm::vec4(c, 0, 1);
+                v.normal = glm::vec4(0, 0, 1, 0);
+                v.lightmapUv = c / 8.0f;
+                m.vertices.push_back(v);
+            }
+            m.triangles.push_back({0, 0, 0, borders * TRIANGLE_CHART_BORDER0});
+        }
+    };
+    quad({1.0f, 1.0f}, {4.6f, 5.0f});
+    quad({4.6f, 1.0f}, {7.0f, 6.0f});
+    m.pageFirstTriangle = {0, 4};
+    return m;
+}
+
+TEST(Supersample, ATexelIsItsChartsHalfSizeTexelsWeightedByItsFootprint) {
+    const BakeMesh mesh = twoCharts();
+    const std::vector<uint32_t> charts = findLightmapCharts(mesh);
+    ASSERT_NE(charts[0], charts[2]) << "A and B are two charts";
+    Layout layout;
+    layout.resolution = 8;
+    layout.pageCount = 1;
+    layout.padding = 1;
+
+    // the texel's quarters: left ones whole, right ones 0.2 (3 of the grid's 16 columns)
+    const std::vector<int32_t> owners = texelOwners(mesh, 0, 8);
+    const std::vector<TexelFootprint> footprints = texelFootprints(mesh, 0, 8, owners, charts);
+    const size_t t = 2 * 8 + 4;
+    ASSERT_GE(owners[t], 0);
+    EXPECT_EQ(charts[size_t(owners[t])], charts[0]);
+    EXPECT_EQ(footprints[t].quarters[0], 256);
+    EXPECT_EQ(footprints[t].quarters[2], 256);
+    EXPECT_EQ(footprints[t].quarters[1], 48);
+    EXPECT_EQ(footprints[t].quarters[3], 48);
+    EXPECT_EQ(footprints[2 * 8 + 2].quarters, (std::array<uint16_t, 4>{256, 256, 256, 256}));
+
+    // the fine bake: A's half-size texels read their x, B's 100 more
+    LightmapPages fine;
+    fine.resolution = 16;
+    const std::vector<int32_t> fineOwners = texelOwners(mesh, 0, 16, nullptr, kMinPartialTexelArea / 4.0);
+    io::ImageRgb img;
+    img.width = img.height = 16;
+    img.pixels.resize(256);
+    std::vector<uint8_t> covered(256);
+    for (size_t i = 0; i < 256; ++i) {
+        if (fineOwners[i] < 0) continue;
+        covered[i] = 1;
+        img.pixels[i] = glm::vec3(float(i % 16) + (charts[size_t(fineOwners[i])] == charts[0] ? 0.0f : 100.0f));
+    }
+    fine.pages.push_back(img);
+    fine.covered.push_back(covered);
+    ASSERT_EQ(charts[size_t(fineOwners[4 * 16 + 9])], charts[2]) << "B owns the right quarters' half-size texels";
+
+    const LightmapPages out = reduceLightmaps(fine, mesh, layout);
+    ASSERT_EQ(out.resolution, 8);
+    EXPECT_EQ(out.filledTexels, 0);
+    EXPECT_FLOAT_EQ(out.pages[0].pixels[2 * 8 + 2].x, 4.5f) << "a whole texel: the mean of its four";
+    EXPECT_FLOAT_EQ(out.pages[0].pixels[t].x, 8.0f) << "A's part only, not B's right quarters";
+    EXPECT_TRUE(out.covered[0][t]);
+    EXPECT_NEAR(out.area[0][t] / 255.0, 0.6, 0.01);
+    // B's texel (5, 2): B's half-size texels 10 and 11
+    EXPECT_FLOAT_EQ(out.pages[0].pixels[2 * 8 + 5].x, 110.5f);
+    // padding takes its covered neighbours' mean, covered only where the layout covers
+    EXPECT_FALSE(out.covered[0][0]);
+    EXPECT_FLOAT_EQ(out.pages[0].pixels[0].x, out.pages[0].pixels[1 * 8 + 1].x);
+}
+
+}  // namespace
+}  // namespace bb
