@@ -520,7 +520,7 @@ def write_outputs(name, cfg, rows, ref_note, ref_seconds):
              (cfg["path"], " ".join(cfg["flags"]), ref_note,
               (", %.1f s" % ref_seconds) if ref_seconds else ""),
              "bundlebake: defaults (bundle resolution from the texel density, 512M budget, stochastic rounding, "
-             "automatic history power), seed %s. Reference sweep: 2 threads, seed %s, flags `%s`." %
+             "automatic history power, supersample auto), seed %s. Reference sweep: 2 threads, seed %s, flags `%s`." %
              (SWEEP_SEED, SWEEP_SEED, " ".join(cfg["reference_flags"]) or "(defaults: emitter sampling on)"), ""]
     if noise is not None:
         lines.append("Estimated noise of the converged reference itself: rel_rmse %.4f (a floor under every error "
