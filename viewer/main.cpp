@@ -61,6 +61,7 @@ struct ViewerArgs {
     std::string env;
     std::string rounding = "stochastic";
     float historyPower = -1.0f;
+    std::string supersample = "auto";  // auto | 1 | 2, as the bake command's
     // viewer
     int width = 1280, height = 720;
     double frameBudgetMs = 30.0;
@@ -331,7 +332,8 @@ Status Viewer::saveLightmaps(const std::string& dir) {
                      {"bundle_res", args_.bundleRes}, {"memory_budget", args_.memoryBudget}, {"seed", args_.seed},
                      {"sky", args_.sky}, {"env", args_.env}, {"rounding", args_.rounding},
                      {"uv_layout", args_.scene.uvLayout}, {"resolution", args_.scene.resolution},
-                     {"texel_density", args_.scene.texelDensity}, {"history_power", baker_->stats().historyPower}};
+                     {"texel_density", args_.scene.texelDensity}, {"history_power", baker_->stats().historyPower},
+                     {"supersample", args_.supersample}};
     info.wallSeconds = bakeSeconds_;
     return writeBakeOutputs(dir, loaded_.scene, loaded_.layout, baker_->readLightmaps(), baker_->stats().toJson(), info);
 }
@@ -708,6 +710,11 @@ int runViewer(int argc, char** argv) {
         ->capture_default_str();
     app.add_option("--history-power", a.historyPower, "History ramp power (-1 = from the largest albedo)")
         ->capture_default_str();
+    app.add_option("--supersample", a.supersample,
+                   "Bake each light map texel as 2 x 2 half-size texels (2) or not (1); auto = 2 when that takes at most "
+                   "half the memory budget")
+        ->check(CLI::IsMember({"auto", "1", "2"}))
+        ->capture_default_str();
     app.add_option("--width", a.width, "Window width")->check(CLI::Range(64, 16384))->capture_default_str();
     app.add_option("--height", a.height, "Window height")->check(CLI::Range(64, 16384))->capture_default_str();
     app.add_option("--frame-budget", a.frameBudgetMs, "Bake milliseconds per frame (at least one bundle tile per frame)")
@@ -755,6 +762,7 @@ int runViewer(int argc, char** argv) {
     options.sky = *sky;
     options.rounding = a.rounding == "nearest" ? Rounding::Nearest : Rounding::Stochastic;
     options.historyPower = a.historyPower;
+    options.supersample = a.supersample == "auto" ? 0 : std::stoi(a.supersample);
     if (!a.env.empty()) {
         auto env = io::readImageRgb(a.env);
         if (!env) return cli::fail(env.error());
