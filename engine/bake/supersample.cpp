@@ -76,19 +76,14 @@ LightmapPages reduceLightmaps(const LightmapPages& fine, const BakeMesh& mesh, c
                 ++out.lostTexels;
             }
         fill.clear();
-        dilate(map, res, layout.padding + 1);
-        io::ImageRgb img;
-        img.width = img.height = res;
-        img.pixels.resize(perPage);
-        for (size_t i = 0; i < perPage; ++i) img.pixels[i] = glm::vec3(map[i]);
-        out.pages.push_back(std::move(img));
+        out.pages.push_back(dilatedImage(std::move(map), res, layout.padding + 1));
         out.covered.push_back(std::move(covered));
         out.area.push_back(std::move(area));
     }
     return out;
 }
 
-void dilate(std::vector<glm::vec4>& map, int res, int passes) {
+io::ImageRgb dilatedImage(std::vector<glm::vec4> map, int res, int passes) {
     for (int pass = 0; pass < passes; ++pass) {
         std::vector<glm::vec4> next = map;
         for (int y = 0; y < res; ++y)
@@ -110,6 +105,11 @@ void dilate(std::vector<glm::vec4>& map, int res, int passes) {
             }
         map.swap(next);
     }
+    io::ImageRgb img;
+    img.width = img.height = res;
+    img.pixels.resize(map.size());
+    for (size_t k = 0; k < map.size(); ++k) img.pixels[k] = glm::vec3(map[k]);
+    return img;
 }
 
 }  // namespace bb

@@ -17,7 +17,7 @@
 // bench city's own atlas, whose generator packs strips several to a texel,
 // has 27 and 374 of 16442, the living room 36 and 0 of 99616. Coverage is
 // the layout's own (texelOwners, as the reference's), and the padding is
-// dilated again (dilate below).
+// dilated again (dilatedImage below).
 //
 // Why: the bounced light a texel reads is its neighbours' means, and a mean
 // over a texel is wrong by its curvature across it (the lintel over a window
@@ -49,8 +49,9 @@ Layout supersampledLayout(const Layout& layout, int k);
 LightmapPages reduceLightmaps(const LightmapPages& fine, const BakeMesh& mesh, const Layout& layout);
 
 // Dilation: a texel without a value (w 0) takes the mean of its 8-neighbours
-// with one (w 1), `passes` times. (The GPU's dilate.comp copies the nearest
-// covered texel instead; both fill what bilinear filtering at chart borders reads.)
-void dilate(std::vector<glm::vec4>& map, int res, int passes);
+// with one (w 1), `passes` times; returns the map's rgb as an image. (The
+// GPU's dilate.comp copies the nearest covered texel instead; both fill what
+// bilinear filtering at chart borders reads.)
+io::ImageRgb dilatedImage(std::vector<glm::vec4> map, int res, int passes);
 
 }  // namespace bb

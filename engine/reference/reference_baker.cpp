@@ -818,12 +818,7 @@ LightmapPages ReferenceBaker::readLightmaps() const {
     for (auto& map : maps) {
         std::vector<uint8_t> cov(perPage);
         for (size_t i = 0; i < perPage; ++i) cov[i] = map[i].w > 0.0f;
-        dilate(map, res, m.layout.padding + 1);
-        io::ImageRgb img;
-        img.width = img.height = res;
-        img.pixels.resize(perPage);
-        for (size_t i = 0; i < perPage; ++i) img.pixels[i] = glm::vec3(map[i]);
-        out.pages.push_back(std::move(img));
+        out.pages.push_back(dilatedImage(std::move(map), res, m.layout.padding + 1));
         out.covered.push_back(std::move(cov));
     }
     return out;

@@ -69,7 +69,12 @@ TEST(CliSeams, ReferenceStitchesTheSameSeams) {
     ASSERT_EQ(stitched.exitCode, 0) << stitched.err;
     const CliResult off = runCli(referenceArgs("off", "off"), tmp);
     ASSERT_EQ(off.exitCode, 0) << off.err;
-    const CliResult bake = runCli(bakeArgs(tmp / "bake"), tmp);
+    // whole texels, as the reference's: a supersampled bake leaves the 36 texels
+    // of the lamps' rims whose chart holds no half-size texel as padding
+    // (bake/supersample.h), and the seams' pairs that tap them are skipped
+    std::vector<std::string> args = bakeArgs(tmp / "bake");
+    args.insert(args.end(), {"--supersample", "1"});
+    const CliResult bake = runCli(args, tmp);
     ASSERT_EQ(bake.exitCode, 0) << bake.err;
 
     const nlohmann::json s = readJson(tmp / "stitched/stats.json");
