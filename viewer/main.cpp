@@ -710,11 +710,7 @@ int runViewer(int argc, char** argv) {
         ->capture_default_str();
     app.add_option("--history-power", a.historyPower, "History ramp power (-1 = from the largest albedo)")
         ->capture_default_str();
-    app.add_option("--supersample", a.supersample,
-                   "Bake each light map texel as 2 x 2 half-size texels (2) or not (1); auto = 2 when that takes at most "
-                   "half the memory budget")
-        ->check(CLI::IsMember({"auto", "1", "2"}))
-        ->capture_default_str();
+    cli::addSupersampleOption(app, a.supersample);
     app.add_option("--width", a.width, "Window width")->check(CLI::Range(64, 16384))->capture_default_str();
     app.add_option("--height", a.height, "Window height")->check(CLI::Range(64, 16384))->capture_default_str();
     app.add_option("--frame-budget", a.frameBudgetMs, "Bake milliseconds per frame (at least one bundle tile per frame)")
@@ -762,7 +758,7 @@ int runViewer(int argc, char** argv) {
     options.sky = *sky;
     options.rounding = a.rounding == "nearest" ? Rounding::Nearest : Rounding::Stochastic;
     options.historyPower = a.historyPower;
-    options.supersample = a.supersample == "auto" ? 0 : std::stoi(a.supersample);
+    options.supersample = cli::supersampleValue(a.supersample);
     if (!a.env.empty()) {
         auto env = io::readImageRgb(a.env);
         if (!env) return cli::fail(env.error());

@@ -865,7 +865,7 @@ LightmapPages Baker::readLightmaps() {
     }
     m.noteMemory();
     if (m.options.supersample == 1) return out;
-    LightmapPages reduced = reduceLightmaps(out, m.mesh, m.outputLayout);
+    LightmapPages reduced = reduceLightmaps(out, m.mesh, m.charts, m.outputLayout);
     if (reduced.lostTexels > 0 && m.stats.supersampleLostTexels == 0)
         logWarning(std::to_string(reduced.lostTexels) + " covered light map texels hold no half-size texel of their chart, nor "
                    "a neighbour on it (charts packed tighter than a texel?): left as padding; --supersample 1 bakes them");

@@ -17,10 +17,10 @@ Layout supersampledLayout(const Layout& layout, int k) {
     return out;
 }
 
-LightmapPages reduceLightmaps(const LightmapPages& fine, const BakeMesh& mesh, const Layout& layout) {
+LightmapPages reduceLightmaps(const LightmapPages& fine, const BakeMesh& mesh, const std::vector<uint32_t>& charts,
+                              const Layout& layout) {
     const int res = layout.resolution, fineRes = fine.resolution;
     const size_t perPage = size_t(res) * res;
-    const std::vector<uint32_t> charts = findLightmapCharts(mesh);
     LightmapPages out;
     out.resolution = res;
     std::vector<std::pair<size_t, glm::vec4>> fill;

@@ -43,10 +43,12 @@ namespace bb {
 Layout supersampledLayout(const Layout& layout, int k);
 
 // `fine`: the light maps of a bake on supersampledLayout(layout, 2), padding
-// dilated; `mesh`: the bake's mesh (either layout's: page UVs are the same).
+// dilated; `mesh`: the bake's mesh (either layout's: page UVs are the same);
+// `charts`: its findLightmapCharts.
 // Returns the light maps of `layout`, with `covered` and `area` by texelOwners
 // and texelFootprints at its resolution.
-LightmapPages reduceLightmaps(const LightmapPages& fine, const BakeMesh& mesh, const Layout& layout);
+LightmapPages reduceLightmaps(const LightmapPages& fine, const BakeMesh& mesh, const std::vector<uint32_t>& charts,
+                              const Layout& layout);
 
 // Dilation: a texel without a value (w 0) takes the mean of its 8-neighbours
 // with one (w 1), `passes` times; returns the map's rgb as an image. (The

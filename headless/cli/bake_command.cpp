@@ -77,11 +77,7 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
                    "Visibility samples over all explicit emitters (0 = max(128, directions / 4))")
         ->check(CLI::Range(0, 1 << 16))
         ->capture_default_str();
-    cmd.add_option("--supersample", a.supersample,
-                   "Bake each light map texel as 2 x 2 half-size texels and average them over its footprint (2), or not (1): "
-                   "less bias and noise for 4x the light-map memory; auto = 2 when that takes at most half the memory budget")
-        ->check(CLI::IsMember({"auto", "1", "2"}))
-        ->capture_default_str();
+    addSupersampleOption(cmd, a.supersample);
     cmd.add_option("--target-noise", a.targetNoise,
                    "Stop once the estimated relative noise of the light maps is at most this (e.g. 0.01; checked at "
                    "radiance refreshes from 16 directions on; --directions is then the most); 0 = off")
@@ -162,7 +158,7 @@ int runBake(const BakeArgs& args) {
     options.emitterSamples = args.emitterSamples;
     options.share = mpi;
     options.targetNoise = args.targetNoise;
-    options.supersample = args.supersample == "auto" ? 0 : std::stoi(args.supersample);
+    options.supersample = supersampleValue(args.supersample);
     if (Status s = loadEnvironment(args.env, options.environment); !s) return fail(s.message());
     auto loaded = loadSceneAndLayout(args.scene);
     if (!loaded) return fail(loaded.error());

@@ -252,4 +252,14 @@ int runInfo(const InfoArgs& args) {
     return 0;
 }
 
+void addSupersampleOption(CLI::App& cmd, std::string& supersample) {
+    cmd.add_option("--supersample", supersample,
+                   "Bake each light map texel as 2 x 2 half-size texels and average them over its footprint (2), or not (1): "
+                   "less bias and noise for 4x the light-map memory; auto = 2 when that takes at most half the memory budget")
+        ->check(CLI::IsMember({"auto", "1", "2"}))
+        ->capture_default_str();
+}
+
+int supersampleValue(const std::string& supersample) { return supersample == "auto" ? 0 : std::stoi(supersample); }
+
 }  // namespace bb::cli

@@ -59,6 +59,9 @@ void addSceneOptions(CLI::App& cmd, SceneArgs& args);
 void addBakeOptions(CLI::App& cmd, BakeArgs& args);
 // --seams stitch|off (bake and reference): UV seams stitched before the light maps are written (bake/seam_stitch.h)
 void addSeamsOption(CLI::App& cmd, std::string& seams);
+// --supersample auto|1|2 (bake and viewer), and its BakeOptions::supersample (auto: 0)
+void addSupersampleOption(CLI::App& cmd, std::string& supersample);
+int supersampleValue(const std::string& supersample);
 
 // Parses "r,g,b" (three finite numbers >= 0) or a single number for grey.
 Expected<glm::vec3> parseColor(const std::string& text, const char* flag);

@@ -73,7 +73,7 @@ TEST(Supersample, ATexelIsItsChartsHalfSizeTexelsWeightedByItsFootprint) {
     fine.covered.push_back(covered);
     ASSERT_EQ(charts[size_t(fineOwners[4 * 16 + 9])], charts[2]) << "B owns the right quarters' half-size texels";
 
-    const LightmapPages out = reduceLightmaps(fine, mesh, layout);
+    const LightmapPages out = reduceLightmaps(fine, mesh, charts, layout);
     ASSERT_EQ(out.resolution, 8);
     EXPECT_EQ(out.filledTexels, 0);
     EXPECT_FLOAT_EQ(out.pages[0].pixels[2 * 8 + 2].x, 4.5f) << "a whole texel: the mean of its four";
