@@ -81,7 +81,7 @@ LID_DENSITY = 0.02
 FAR_PATH = "bench/cache/cornell_box_far_5km.gltf"
 FAR = [5000.0, 0.0, 5000.0]
 FURNACE_RHO099_PATH = "bench/cache/furnace_rho099.gltf"
-CANYON_PATH = "bench/cache/street_canyon.gltf"
+CANYON_PATH = "assets/street_canyon/street_canyon.gltf"  # scripts/make_assets.py
 
 
 def write_atomic(path, data):
@@ -201,34 +201,6 @@ def make_furnace_rho099():
     derived_gltf("assets/furnace/furnace_rho09.gltf", FURNACE_RHO099_PATH, albedo)
 
 
-def make_street_canyon():
-    """A street canyon with recessed window bands (issue 11, design notes "Where the city's remaining bias is"):
-    two walls 10 m high, 6 m apart and 12 m long (albedo 0.6) over a black street, each with a band from 4 to
-    5.5 m recessed 35 cm (sill, recessed wall, lintel), under a uniform sky; charts packed by
-    scripts/make_assets.py at ~1.24 texels a metre at 32^2, the sills and lintels a texel across."""
-    sys.path.insert(0, os.path.join(ROOT, "scripts"))
-    import make_assets as M
-
-    def wall(side):
-        s = -1.0 if side == "A" else 1.0
-        x0, xr, n, L = 3.0 * s, 3.35 * s, (-s, 0.0, 0.0), 6.0
-        quads = [("lower", [(x0, 0, -L), (x0, 0, L), (x0, 4, L), (x0, 4, -L)], n),
-                 ("sill", [(x0, 4, -L), (x0, 4, L), (xr, 4, L), (xr, 4, -L)], (0, 1, 0)),
-                 ("recess", [(xr, 4, -L), (xr, 4, L), (xr, 5.5, L), (xr, 5.5, -L)], n),
-                 ("lintel", [(x0, 5.5, -L), (x0, 5.5, L), (xr, 5.5, L), (xr, 5.5, -L)], (0, -1, 0)),
-                 ("upper", [(x0, 5.5, -L), (x0, 5.5, L), (x0, 10, L), (x0, 10, -L)], n)]
-        return [("%s_%s" % (side, name), "wall", [M.Face("%s_%s" % (side, name), pts, normal)])
-                for name, pts, normal in quads]
-
-    street = M.Face("street", [(-3, 0, -6), (3, 0, -6), (3, 0, 6), (-3, 0, 6)], (0, 1, 0))
-    eye = (0.0, 8.0, 14.0)
-    camera = {"name": "canyon_camera", "translation": list(eye), "rotation": M.look_at_rotation(eye, (0, 4, 0)),
-              "yfov": 1.0, "aspectRatio": 1.0, "znear": 0.05, "zfar": 100.0}
-    scene = M.Scene("street_canyon", [M.material("wall", (0.6, 0.6, 0.6)), M.material("black", (0.0, 0.0, 0.0))],
-                    wall("A") + wall("B") + [("street", "black", [street])], camera)
-    M.write_scene(scene, os.path.join(ROOT, os.path.dirname(CANYON_PATH)), "street_canyon")
-
-
 # Per scene: the shared flags (layout, lighting) and each baker's points. The
 # reference's flags are its best on this machine (2 threads; emitter sampling
 # on, except the furnaces, where every surface emits and cosine sampling alone
@@ -332,7 +304,6 @@ SCENES = {
     # texels near the corner they darken
     "street_canyon": {
         "path": CANYON_PATH,
-        "make": make_street_canyon,
         "flags": ["--uv-layout", "asset", "--resolution", "32", "--sky", "1,1,1"],
         "directions": DIRECTIONS,
         "spp": [4, 16, 64, 256, 1024, 4096],

@@ -464,6 +464,30 @@ TR = {"ax0": -2.01, "ax1": -0.01, "bx0": 0.01, "bx1": 2.01, "y1": 2.0, "z": 1.0,
       "panel": (-1.26, -0.76, -0.25, 0.25), "door_z": 0.2, "door_h": 1.0}
 
 
+def street_canyon():
+    """A street canyon with recessed window bands: two walls 10 m high, 6 m apart and 12 m long (albedo 0.6) over
+    a black street, each with a band from 4 to 5.5 m recessed 35 cm (sill, recessed wall, lintel), under a sky.
+    The sills and lintels, 35 cm deep, are strips under half a texel across at 32x32 (the generated city's
+    ledges and sills are a fifth of a texel): issue 11's bench scene and the noise estimate's sliver test."""
+    def wall(side):
+        s = -1.0 if side == "A" else 1.0
+        x0, xr, n, L = 3.0 * s, 3.35 * s, (-s, 0.0, 0.0), 6.0
+        quads = [("lower", [(x0, 0, -L), (x0, 0, L), (x0, 4, L), (x0, 4, -L)], n),
+                 ("sill", [(x0, 4, -L), (x0, 4, L), (xr, 4, L), (xr, 4, -L)], (0, 1, 0)),
+                 ("recess", [(xr, 4, -L), (xr, 4, L), (xr, 5.5, L), (xr, 5.5, -L)], n),
+                 ("lintel", [(x0, 5.5, -L), (x0, 5.5, L), (xr, 5.5, L), (xr, 5.5, -L)], (0, -1, 0)),
+                 ("upper", [(x0, 5.5, -L), (x0, 5.5, L), (x0, 10, L), (x0, 10, -L)], n)]
+        return [("%s_%s" % (side, name), "wall", [Face("%s_%s" % (side, name), pts, normal)])
+                for name, pts, normal in quads]
+
+    street = Face("street", [(-3, 0, -6), (3, 0, -6), (3, 0, 6), (-3, 0, 6)], (0, 1, 0))
+    eye = (0.0, 8.0, 14.0)
+    camera = {"name": "canyon_camera", "translation": list(eye), "rotation": look_at_rotation(eye, (0, 4, 0)),
+              "yfov": 1.0, "aspectRatio": 1.0, "znear": 0.05, "zfar": 100.0}
+    return Scene("street_canyon", [material("wall", (0.6, 0.6, 0.6)), material("black", (0.0, 0.0, 0.0))],
+                 wall("A") + wall("B") + [("street", "black", [street])], camera)
+
+
 def two_rooms(doorway):
     ax0, ax1, bx0, bx1, y1, Z = TR["ax0"], TR["ax1"], TR["bx0"], TR["bx1"], TR["y1"], TR["z"]
     dz, dh = TR["door_z"], TR["door_h"]
@@ -1041,6 +1065,14 @@ def write_readme(assets, report, probes):
          ob["floor_0.25_0.1"]["sky_view_factor"], uv("open_box", "floor_0.25_0.1"),
          ob["wall_xmin_centre"]["sky_view_factor"], uv("open_box", "wall_xmin_centre")))
     w("")
+    w("**`street_canyon/street_canyon.gltf`**: a street 6 m wide (x in [-3, 3], z in [-6, 6], black) between two "
+      "walls 10 m high (albedo 0.6, facing the street), each with a window band from y = 4 to 5.5 m recessed 0.35 m "
+      "(sill facing +Y, recessed wall, lintel facing -Y); open above and at both ends. %s: at the `bench/"
+      "speed_vs_error.py` street canyon's 32x32 (--uv-layout asset) the sills and lintels are strips under half a "
+      "texel across, as the generated city's ledges and sills. No closed form: the bench measures it against a "
+      "converged `bundlebake reference` under a uniform sky, the noise estimate test against its seed-to-seed "
+      "noise. Source: generated." % layout("street_canyon"))
+    w("")
     w(SHARED_SECTION)
     with open(os.path.join(assets, "README.md"), "w") as fh:
         fh.write("\n".join(lines))
@@ -1227,6 +1259,10 @@ def main():
     probes["scenes"]["open_box"] = {"file": "open_box/open_box.gltf", "rho": 0.0, "probes": pr,
                                     "note": "black surfaces: one iteration is already exact"}
     report["open_box"]["v"] = (v_centre, v_off, v_wall)
+
+    # 6. street canyon ----------------------------------------------------------
+    L = emit(street_canyon(), "street_canyon", "street_canyon")
+    check_orientation(L, C, {m: ((0.0, 5.0, 0.0), 1) for m, _, _ in report["street_canyon"]["scene"].meshes})
 
     for sname, entry in probes["scenes"].items():
         Lp = report[sname]["loaded"]

@@ -17,6 +17,27 @@ Layout supersampledLayout(const Layout& layout, int k) {
     return out;
 }
 
+TexelQuarters texelQuarters(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res) {
+    TexelQuarters out;
+    out.owner = texelOwners(mesh, page, res);
+    const std::vector<TexelFootprint> footprints = texelFootprints(mesh, page, res, out.owner, charts);
+    const std::vector<int32_t> fineOwner = texelOwners(mesh, page, 2 * res, nullptr, kMinPartialTexelArea / 4.0);
+    const size_t perPage = size_t(res) * res;
+    out.area.resize(perPage);
+    out.weights.assign(perPage, glm::vec4(0.0f));
+    for (size_t i = 0; i < perPage; ++i) {
+        if (out.owner[i] < 0) continue;
+        const int x = int(i % size_t(res)), y = int(i / size_t(res));
+        out.area[i] = footprints[i].area;
+        for (int q = 0; q < 4; ++q) {
+            const int32_t o = fineOwner[size_t(2 * y + q / 2) * size_t(2 * res) + size_t(2 * x + q % 2)];
+            if (o >= 0 && charts[size_t(o)] == charts[size_t(out.owner[i])])
+                out.weights[i][q] = float(footprints[i].quarters[size_t(q)]);
+        }
+    }
+    return out;
+}
+
 LightmapPages reduceLightmaps(const LightmapPages& fine, const BakeMesh& mesh, const std::vector<uint32_t>& charts,
                               const Layout& layout) {
     const int res = layout.resolution, fineRes = fine.resolution;
@@ -25,27 +46,24 @@ LightmapPages reduceLightmaps(const LightmapPages& fine, const BakeMesh& mesh, c
     out.resolution = res;
     std::vector<std::pair<size_t, glm::vec4>> fill;
     for (int p = 0; p < layout.pageCount; ++p) {
-        const std::vector<int32_t> owner = texelOwners(mesh, p, res);
-        const std::vector<TexelFootprint> footprints = texelFootprints(mesh, p, res, owner, charts);
-        const std::vector<int32_t> fineOwner = texelOwners(mesh, p, fineRes, nullptr, kMinPartialTexelArea / 4.0);
+        const TexelQuarters quarters = texelQuarters(mesh, charts, p, res);
+        const std::vector<int32_t>& owner = quarters.owner;
         const io::ImageRgb& from = fine.pages[size_t(p)];
         std::vector<glm::vec4> map(perPage, glm::vec4(0.0f));
-        std::vector<uint8_t> covered(perPage), area(perPage);
+        std::vector<uint8_t> covered(perPage), area = quarters.area;
         for (size_t i = 0; i < perPage; ++i) {
-            const TexelFootprint& f = footprints[i];
             const int x = int(i % size_t(res)), y = int(i / size_t(res));
             if (owner[i] < 0) continue;
             glm::dvec3 sum(0.0);
             double weight = 0.0;
             for (int q = 0; q < 4; ++q) {
                 const size_t j = size_t(2 * y + q / 2) * size_t(fineRes) + size_t(2 * x + q % 2);
-                if (!fine.covered[size_t(p)][j] || fineOwner[j] < 0 || charts[size_t(fineOwner[j])] != charts[size_t(owner[i])])
-                    continue;
-                sum += glm::dvec3(from.pixels[j]) * double(f.quarters[size_t(q)]);
-                weight += f.quarters[size_t(q)];
+                const double w = quarters.weights[i][q];
+                if (w == 0.0 || !fine.covered[size_t(p)][j]) continue;
+                sum += glm::dvec3(from.pixels[j]) * w;
+                weight += w;
             }
             covered[i] = 1;
-            area[i] = f.area;
             if (weight > 0.0) map[i] = glm::vec4(glm::vec3(sum / weight), 1.0f);
         }
         // texels with no half-size texel of their own: their chart's neighbours' mean, else padding

@@ -42,6 +42,20 @@ namespace bb {
 // and rectangles times k; the page UVs (rectangles' scale and offset) stay.
 Layout supersampledLayout(const Layout& layout, int k);
 
+// Page `page` of a layout at resolution `res`, as reduceLightmaps reads it:
+// per texel its owner (texelOwners), footprint area (texelFootprints, 255ths)
+// and its four half-size texels' weights in it (x + 2 y, y up the page): the
+// footprint's points in each quarter, 0 where no half-size texel of the
+// texel's own chart is (texelOwners at 2 res with a quarter of
+// kMinPartialTexelArea); all 0 for a texel not covered. The noise estimate
+// weighs the half-size texels by them too (Baker::Impl::estimateNoise).
+struct TexelQuarters {
+    std::vector<int32_t> owner;
+    std::vector<uint8_t> area;
+    std::vector<glm::vec4> weights;
+};
+TexelQuarters texelQuarters(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res);
+
 // `fine`: the light maps of a bake on supersampledLayout(layout, 2), padding
 // dilated; `mesh`: the bake's mesh (either layout's: page UVs are the same);
 // `charts`: its findLightmapCharts.

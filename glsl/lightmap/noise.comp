@@ -5,10 +5,10 @@
 // minus the odd: M_e = (M W - M_o W_o) / (W - W_o)). Writes (sum over RGB of
 // (M_e - M_o)^2, sum over RGB of L_lm, 1) for texels where both halves hold
 // samples, zeros elsewhere; the CPU sums and scales by the halves' weights
-// (noise.cpp noiseHalvesFactor). A supersampled bake's texel is the mean of
-// its supersample^2 half-size texels (bake/supersample.h): M_e - M_o and L_lm
-// are those texels' means (equal weights; the reduction weighs them by their
-// parts of the footprint), over those where both halves hold samples.
+// (noise.cpp noiseHalvesFactor). A supersampled bake's texel is its half-size
+// texels' mean weighted by their parts of its footprint (bake/supersample.h
+// texelQuarters; `weights`, x + 2 y): M_e - M_o and L_lm are those texels'
+// means at those weights, over those where both halves hold samples.
 #include "shared/bundle_layout.h"
 #include "lib/rounding.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -17,6 +17,7 @@ layout(binding = BINDING_ACCUM, rg32ui) uniform readonly uimage2DArray accum;
 layout(binding = BINDING_HALF_ACCUM, rg32ui) uniform readonly uimage2DArray halfAccum;
 layout(binding = BINDING_DIRECT, rgba16f) uniform readonly image2DArray directMap;
 layout(binding = BINDING_TARGET, rgba32f) uniform writeonly image2DArray target;
+layout(binding = BINDING_NOISE_WEIGHTS, rgba16f) uniform readonly image2DArray weights;
 uniform int halfStride;
 uniform int supersample;
 uniform int pageCount;
@@ -27,6 +28,7 @@ void main() {
     if (h.x >= pageSize.x || h.y >= pageSize.y || h.z >= pageCount) return;
     vec3 d = vec3(0.0), l = vec3(0.0);
     float n = 0.0;
+    vec4 w = imageLoad(weights, h);
     for (int j = 0; j < supersample; ++j)
         for (int i = 0; i < supersample; ++i) {
             ivec2 sub = ivec2(i, j);
@@ -35,11 +37,12 @@ void main() {
             vec4 odd = decodeAccumulator(imageLoad(halfAccum, ivec3(h.xy * supersample + sub, h.z)).rg);
             float evenWeight = whole.a - odd.a;
             // both halves need weight; the whole's W rounds (7 bits), so ask for a margin
-            if (odd.a <= 0.0 || evenWeight <= 0.02 * whole.a) continue;
+            float weight = w[i + 2 * j];
+            if (weight <= 0.0 || odd.a <= 0.0 || evenWeight <= 0.02 * whole.a) continue;
             vec3 even = (whole.rgb * whole.a - odd.rgb * odd.a) / evenWeight;
-            d += even - odd.rgb;
-            l += whole.rgb + imageLoad(directMap, t).rgb;
-            n += 1.0;
+            d += weight * (even - odd.rgb);
+            l += weight * (whole.rgb + imageLoad(directMap, t).rgb);
+            n += weight;
         }
     if (n == 0.0) {
         imageStore(target, h, vec4(0.0));
