@@ -708,7 +708,7 @@ int runViewer(int argc, char** argv) {
     app.add_option("--rounding", a.rounding, "fp16/RGBE conversion: stochastic or nearest")
         ->check(CLI::IsMember({"stochastic", "nearest"}))
         ->capture_default_str();
-    app.add_option("--history-power", a.historyPower, "History ramp power (-1 = from the largest albedo)")
+    app.add_option("--history-power", a.historyPower, "History ramp power (-1 = from the scene's transport albedo)")
         ->capture_default_str();
     cli::addSupersampleOption(app, a.supersample);
     app.add_option("--width", a.width, "Window width")->check(CLI::Range(64, 16384))->capture_default_str();

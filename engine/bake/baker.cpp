@@ -11,6 +11,7 @@
 
 #include "bake/baker_impl.h"
 #include "bake/supersample.h"
+#include "bake/transport_albedo.h"
 #include "bake/directions.h"
 #include "core/check.h"
 #include "core/log.h"
@@ -93,7 +94,8 @@ nlohmann::json BakeStats::toJson() const {
     nlohmann::json j;
     j["directions"] = {{"done", directionsDone}, {"total", directionsTotal}};
     j["bundle"] = {{"resolution_pixels", bundleResolution}, {"pixel_size_scene_units", pixelSize},
-                   {"history_power", historyPower}, {"radiance_unit", radianceUnit}};
+                   {"history_power", historyPower}, {"transport_albedo", transportAlbedo},
+                   {"radiance_unit", radianceUnit}};
     auto pct = [&](double q) { return quantile(predictedOverActual, q); };
     auto size = [&](double q) { return quantile(tilePixelSizes, q); };
     int maxTiles = tilesPerDirection.empty() ? 0 : *std::max_element(tilesPerDirection.begin(), tilesPerDirection.end());
@@ -145,8 +147,8 @@ nlohmann::json BakeStats::toJson() const {
     return j;
 }
 
-double defaultHistoryPower(double largestAlbedo) {
-    const double rho = std::min(largestAlbedo, 0.99);
+double defaultHistoryPower(double transportAlbedo) {
+    const double rho = std::min(transportAlbedo, 0.99);
     return std::clamp(std::round(2.0 * rho / std::pow(1.0 - rho, 1.5)), 1.0, 1024.0);
 }
 
@@ -597,14 +599,20 @@ Status Baker::Impl::init(const Scene& scene) {
     // factor 1 on a dark texture as rho 1: the ramp's power 1024, only the
     // last half of the directions counting, and a refresh after each of the
     // first 690 rounds). mixed_lighting's red velvet is rho 0.995 in red.
-    float rho = 0;
+    // Since 2026-12-04 that albedo is the scene's transport albedo (bake/
+    // transport_albedo.h), the share of the light that comes back each bounce,
+    // not the largest albedo: the same in a closed room of one albedo, less
+    // where light escapes (mixed_lighting's velvet, the city under its sky).
+    std::vector<glm::vec3> albedos;
+    std::vector<bool> doubleSided;
     for (const auto& m : materials) {
-        const glm::vec3 albedo = m.albedo * (m.albedoTexture >= 0 ? textureMeans[size_t(m.albedoTexture)] : glm::vec3(1.0f));
-        rho = std::max({rho, albedo.r, albedo.g, albedo.b});
+        albedos.push_back(m.albedo * (m.albedoTexture >= 0 ? textureMeans[size_t(m.albedoTexture)] : glm::vec3(1.0f)));
+        doubleSided.push_back(m.doubleSided);
     }
-    rho = std::min(rho, 0.99f);
+    const double rho = std::min(transportAlbedo(mesh, albedos, doubleSided), 0.99);
+    stats.transportAlbedo = rho;
     historyPower = options.historyPower >= 0 ? options.historyPower : defaultHistoryPower(rho);
-    refreshEveryRound = std::max(64, int(std::ceil(std::log(1000.0) / (1.0 - double(rho)))));
+    refreshEveryRound = std::max(64, int(std::ceil(std::log(1000.0) / (1.0 - rho))));
     stats.historyPower = historyPower;
     directions = makeDirections(options.directions, options.seed);
     sanitizeInputs(scene);

@@ -56,7 +56,7 @@ struct BakeOptions {
     Rounding rounding = Rounding::Stochastic;
     // History ramp: direction k is weighted min(k, directions/2)^power, so early
     // directions (which saw light maps with few bounces) fade out. < 0 = from
-    // the scene's largest albedo (defaultHistoryPower).
+    // the scene's transport albedo (defaultHistoryPower, bake/transport_albedo.h).
     float historyPower = -1.0f;
     // Cut each tile until its predicted node count (projected cluster areas /
     // pixel area) fits 80 % of the budget's node buffer, and size the buffer
@@ -104,6 +104,7 @@ struct BakeStats {
     double bundleResolution = 0;      // pixels across the bounding sphere (the uniform grid)
     double pixelSize = 0;             // scene units (the uniform grid's; tiles: tilePixelSizes)
     double historyPower = 0;
+    double transportAlbedo = 0;       // the light's share kept per bounce (bake/transport_albedo.h)
     double radianceUnit = 1;          // the light-map state holds radiance / this (a power of two; fp16 range)
     int64_t tilesDrawn = 0;
     int64_t overflows = 0;            // tile draws whose node count exceeded the buffer: redrawn (bigger buffer, or split)
@@ -176,9 +177,9 @@ struct BakeProgress {
 };
 
 // BakeOptions::historyPower < 0: round(2 rho / (1 - rho)^1.5) in [1, 1024] for
-// the scene's largest albedo rho (capped at 0.99): the more bounces light
+// the scene's transport albedo rho (capped at 0.99): the more bounces light
 // needs, the faster the early directions fade (docs/design-notes.md).
-double defaultHistoryPower(double largestAlbedo);
+double defaultHistoryPower(double transportAlbedo);
 
 // The light maps of a bake: one image per page, L_lm = E/pi (DESIGN.md Units),
 // texel row 0 = v 0 (GL order), padding dilated. `covered` marks texels whose

@@ -66,7 +66,7 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
         ->check(CLI::IsMember({"stochastic", "nearest"}))
         ->capture_default_str();
     cmd.add_option("--history-power", a.historyPower,
-                   "Weight direction k by min(k, N/2)^p to fade early, few-bounce directions (-1 = from the largest albedo)")
+                   "Weight direction k by min(k, N/2)^p to fade early, few-bounce directions (-1 = from the scene's transport albedo, the light's share kept per bounce)")
         ->capture_default_str();
     cmd.add_option("--direct", a.direct,
                    "Direct light from emissive triangles: explicit (form factor x shadow cube maps), bundles, or auto "

@@ -183,10 +183,11 @@ TEST(FurnaceBake, BeyondTheFp16RangeReadsTheAnalyticValue) { runScaledFurnace(1e
 TEST(FurnaceBake, FarBelowOneReadsTheAnalyticValue) { runScaledFurnace(1e-5f); }
 
 // The history ramp's power and the refresh schedule follow the scene's
-// largest albedo (defaultHistoryPower), a textured material's being its
-// factor times its texture's mean: a factor of 1 on a texture of mean 0.5
-// (texels 0.3 and 0.7) is rho 0.5 (power 3), not 1 (the cap, 1024: only the
-// last half of the directions would count). Exact.
+// transport albedo (defaultHistoryPower, bake/transport_albedo.h), a textured
+// material's albedo being its factor times its texture's mean: in a closed
+// room of one material, a factor of 1 on a texture of mean 0.5 (texels 0.3
+// and 0.7) is rho 0.5 (power 3), not 1 (the cap, 1024: only the last half of
+// the directions would count).
 TEST(HistoryRamp, TexturedAlbedoCountsAtItsTexturesMean) {
     BB_REQUIRE_GL();
     Scene scene;
@@ -198,14 +199,15 @@ TEST(HistoryRamp, TexturedAlbedoCountsAtItsTexturesMean) {
     scene.textures.push_back(grey);
     const int textured = addMaterial(scene, glm::vec3(1.0f));
     scene.materials[size_t(textured)].albedoTexture = 0;
-    addQuad(scene, glm::vec3(0.0f), glm::vec3(1.0f, 0.0f, 0.0f), glm::vec3(0.0f, 0.0f, -1.0f), textured, "floor");
-    auto layout = packLayout(scene, 32, 10.0f);
+    addBox(scene, glm::vec3(0.0f), glm::vec3(1.0f), textured, false, "room");
+    auto layout = packLayout(scene, 32, 4.0f);
     ASSERT_TRUE(layout) << layout.error();
     BakeOptions options;
     options.directions = 4;
     BakeStats stats;
     auto maps = bakeGpu(scene, *layout, options, nullptr, &stats);
     ASSERT_TRUE(maps) << maps.error();
+    EXPECT_NEAR(stats.transportAlbedo, 0.5, 1e-3);
     EXPECT_EQ(stats.historyPower, defaultHistoryPower(0.5));
     EXPECT_EQ(defaultHistoryPower(0.5), 3.0);
 }

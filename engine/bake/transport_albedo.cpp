@@ -1,0 +1,139 @@
+#include "bake/transport_albedo.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <embree3/rtcore.h>
+
+namespace bb {
+namespace {
+
+constexpr int kBounces = 5;
+
+uint64_t splitmix(uint64_t& state) {
+    uint64_t z = (state += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+}
+
+float uniform(uint64_t& state) { return float(splitmix(state) >> 40) * (1.0f / 16777216.0f); }
+
+struct Triangle {
+    glm::vec3 p0, e1, e2;
+    glm::vec3 n;  // unit geometric normal on the side the shading normal faces
+};
+
+}  // namespace
+
+double transportAlbedo(const BakeMesh& mesh, const std::vector<glm::vec3>& albedo, const std::vector<bool>& doubleSided,
+                       int paths) {
+    const size_t n = mesh.triangles.size();
+    if (n == 0 || paths <= 0) return 0.0;
+    std::vector<Triangle> tris(n);
+    std::vector<double> cdf(n);
+    double area = 0.0;
+    for (size_t t = 0; t < n; ++t) {
+        const glm::vec3 a(mesh.vertices[3 * t].position), b(mesh.vertices[3 * t + 1].position),
+            c(mesh.vertices[3 * t + 2].position);
+        Triangle& tri = tris[t];
+        tri.p0 = a;
+        tri.e1 = b - a;
+        tri.e2 = c - a;
+        const glm::vec3 cr = glm::cross(tri.e1, tri.e2);
+        const float len = glm::length(cr);
+        tri.n = len > 0.0f ? cr / len : glm::vec3(0.0f);
+        const glm::vec3 ns(mesh.vertices[3 * t].normal + mesh.vertices[3 * t + 1].normal + mesh.vertices[3 * t + 2].normal);
+        if (glm::dot(ns, tri.n) < 0.0f) tri.n = -tri.n;
+        area += 0.5 * double(len);
+        cdf[t] = area;
+    }
+    if (area <= 0.0) return 0.0;
+
+    RTCDevice device = rtcNewDevice("threads=1");
+    if (!device) return 0.0;
+    RTCScene scene = rtcNewScene(device);
+    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vb = static_cast<float*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * n));
+    auto* ib = static_cast<uint32_t*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), n));
+    for (size_t i = 0; vb && ib && i < 3 * n; ++i) {
+        vb[3 * i] = mesh.vertices[i].position.x;
+        vb[3 * i + 1] = mesh.vertices[i].position.y;
+        vb[3 * i + 2] = mesh.vertices[i].position.z;
+        ib[i] = uint32_t(i);
+    }
+    rtcCommitGeometry(geom);
+    rtcAttachGeometry(scene, geom);
+    rtcReleaseGeometry(geom);
+    rtcCommitScene(scene);
+
+    // the ray offset: a millionth of the scene's extent past the surface
+    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    for (const BakeVertex& v : mesh.vertices) {
+        lo = glm::min(lo, glm::vec3(v.position));
+        hi = glm::max(hi, glm::vec3(v.position));
+    }
+    const float offset = 1e-5f * std::max(1e-3f, glm::length(hi - lo));
+
+    std::vector<glm::dvec3> sums(kBounces + 1, glm::dvec3(0.0));  // E_k x paths, k = 0..kBounces
+    uint64_t rng = 0x5eed5eedull;
+    for (int p = 0; p < paths; ++p) {
+        // a point by area, then k cosine rays
+        const double pick = (double(p) + double(uniform(rng))) / double(paths) * area;
+        size_t t = size_t(std::lower_bound(cdf.begin(), cdf.end(), pick) - cdf.begin());
+        t = std::min(t, n - 1);
+        bool flip = false;  // on a double-sided triangle's back
+        glm::vec3 weight(1.0f);
+        for (int k = 0; k <= kBounces; ++k) {
+            const Triangle& tri = tris[t];
+            const glm::vec3 normal = flip ? -tri.n : tri.n;
+            float u = uniform(rng), v = uniform(rng);
+            if (u + v > 1.0f) {
+                u = 1.0f - u;
+                v = 1.0f - v;
+            }
+            const glm::vec3 point = tri.p0 + u * tri.e1 + v * tri.e2;
+            weight *= albedo[mesh.triangles[t].material];
+            sums[size_t(k)] += glm::dvec3(weight);
+            if (k == kBounces) break;
+            // cosine direction about tri.n
+            const float r = std::sqrt(uniform(rng)), phi = 6.28318531f * uniform(rng);
+            const glm::vec3 axis = std::abs(normal.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
+            const glm::vec3 tx = glm::normalize(glm::cross(axis, normal)), ty = glm::cross(normal, tx);
+            const glm::vec3 dir = r * std::cos(phi) * tx + r * std::sin(phi) * ty +
+                                  std::sqrt(std::max(0.0f, 1.0f - r * r)) * normal;
+            RTCIntersectContext context;
+            rtcInitIntersectContext(&context);
+            RTCRayHit rh{};
+            const glm::vec3 origin = point + offset * normal;
+            rh.ray.org_x = origin.x;
+            rh.ray.org_y = origin.y;
+            rh.ray.org_z = origin.z;
+            rh.ray.dir_x = dir.x;
+            rh.ray.dir_y = dir.y;
+            rh.ray.dir_z = dir.z;
+            rh.ray.tnear = 0.0f;
+            rh.ray.tfar = std::numeric_limits<float>::infinity();
+            rh.ray.mask = 0xFFFFFFFFu;
+            rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+            rtcIntersect1(scene, &context, &rh);
+            if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
+            t = rh.hit.primID;
+            // a single-sided surface's back absorbs; a double-sided one is seen from the side the ray meets
+            flip = glm::dot(dir, tris[t].n) > 0.0f;
+            if (flip && !doubleSided[mesh.triangles[t].material]) break;
+        }
+    }
+    rtcReleaseScene(scene);
+    rtcReleaseDevice(device);
+    double lambda = 0.0;
+    for (int c = 0; c < 3; ++c)
+        if (sums[kBounces - 1][c] > 0.0) lambda = std::max(lambda, sums[kBounces][c] / sums[kBounces - 1][c]);
+    return std::min(lambda, 0.999);
+}
+
+}  // namespace bb
