@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include <embree3/rtcore.h>
+#include "reference/embree_mesh.h"
 
 namespace bb {
 namespace {
@@ -53,23 +53,11 @@ double transportAlbedo(const BakeMesh& mesh, const std::vector<glm::vec3>& albed
 
     RTCDevice device = rtcNewDevice("threads=1");
     if (!device) return 0.0;
-    RTCScene scene = rtcNewScene(device);
-    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
-    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* vb = static_cast<float*>(
-        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * n));
-    auto* ib = static_cast<uint32_t*>(
-        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), n));
-    for (size_t i = 0; vb && ib && i < 3 * n; ++i) {
-        vb[3 * i] = mesh.vertices[i].position.x;
-        vb[3 * i + 1] = mesh.vertices[i].position.y;
-        vb[3 * i + 2] = mesh.vertices[i].position.z;
-        ib[i] = uint32_t(i);
+    RTCScene scene = commitBakeMeshScene(device, mesh, RTC_BUILD_QUALITY_MEDIUM);
+    if (!scene) {
+        rtcReleaseDevice(device);
+        return 0.0;
     }
-    rtcCommitGeometry(geom);
-    rtcAttachGeometry(scene, geom);
-    rtcReleaseGeometry(geom);
-    rtcCommitScene(scene);
 
     // the ray offset: a millionth of the scene's extent past the surface
     glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
@@ -106,22 +94,8 @@ double transportAlbedo(const BakeMesh& mesh, const std::vector<glm::vec3>& albed
             const glm::vec3 tx = glm::normalize(glm::cross(axis, normal)), ty = glm::cross(normal, tx);
             const glm::vec3 dir = r * std::cos(phi) * tx + r * std::sin(phi) * ty +
                                   std::sqrt(std::max(0.0f, 1.0f - r * r)) * normal;
-            RTCIntersectContext context;
-            rtcInitIntersectContext(&context);
-            RTCRayHit rh{};
-            const glm::vec3 origin = point + offset * normal;
-            rh.ray.org_x = origin.x;
-            rh.ray.org_y = origin.y;
-            rh.ray.org_z = origin.z;
-            rh.ray.dir_x = dir.x;
-            rh.ray.dir_y = dir.y;
-            rh.ray.dir_z = dir.z;
-            rh.ray.tnear = 0.0f;
-            rh.ray.tfar = std::numeric_limits<float>::infinity();
-            rh.ray.mask = 0xFFFFFFFFu;
-            rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-            rtcIntersect1(scene, &context, &rh);
-            if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
+            RTCRayHit rh;
+            if (!intersectRay(scene, point + offset * normal, dir, rh)) break;
             t = rh.hit.primID;
             // a single-sided surface's back absorbs; a double-sided one is seen from the side the ray meets
             flip = glm::dot(dir, tris[t].n) > 0.0f;

@@ -3,6 +3,7 @@
 // about how.
 #include "reference/reference_baker.h"
 #include "bake/supersample.h"
+#include "reference/embree_mesh.h"
 #include "scene/punctual_light.h"
 
 #include <algorithm>
@@ -314,27 +315,8 @@ Status ReferenceBaker::Impl::init(const Scene& scene) {
     device = rtcNewDevice(config.c_str());
     if (!device) return Status::error("embree: cannot create a device (error " + std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
     rtcSetDeviceErrorFunction(device, embreeError, nullptr);
-    rtcScene = rtcNewScene(device);
-    rtcSetSceneFlags(rtcScene, RTC_SCENE_FLAG_ROBUST);  // watertight: no leaks through shared edges
-    rtcSetSceneBuildQuality(rtcScene, RTC_BUILD_QUALITY_HIGH);
-    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* vb = static_cast<float*>(
-        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * n));
-    auto* ib = static_cast<uint32_t*>(
-        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), n));
-    if (!vb || !ib) return Status::error("embree: cannot allocate the geometry buffers");
-    for (size_t i = 0; i < 3 * n; ++i) {
-        vb[3 * i] = mesh.vertices[i].position.x;
-        vb[3 * i + 1] = mesh.vertices[i].position.y;
-        vb[3 * i + 2] = mesh.vertices[i].position.z;
-        ib[i] = uint32_t(i);
-    }
-    rtcCommitGeometry(geom);
-    rtcAttachGeometry(rtcScene, geom);
-    rtcReleaseGeometry(geom);
-    rtcCommitScene(rtcScene);
-    if (RTCError e = rtcGetDeviceError(device); e != RTC_ERROR_NONE)
-        return Status::error("embree: scene build failed (error " + std::to_string(int(e)) + ")");
+    rtcScene = commitBakeMeshScene(device, mesh, RTC_BUILD_QUALITY_HIGH);
+    if (!rtcScene) return Status::error("embree: scene build failed (error " + std::to_string(int(rtcGetDeviceError(device))) + ")");
 
     findTexels();
     sums.assign(texels.size(), glm::dvec3(0.0));
@@ -497,24 +479,7 @@ SurfacePoint ReferenceBaker::Impl::footprintPoint(const Texel& texel, float u1, 
 }
 
 bool ReferenceBaker::Impl::intersect(const glm::vec3& origin, const glm::vec3& dir, RTCRayHit& rh) const {
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    rh.ray.org_x = origin.x;
-    rh.ray.org_y = origin.y;
-    rh.ray.org_z = origin.z;
-    rh.ray.dir_x = dir.x;
-    rh.ray.dir_y = dir.y;
-    rh.ray.dir_z = dir.z;
-    rh.ray.tnear = 0.0f;
-    rh.ray.tfar = std::numeric_limits<float>::infinity();
-    rh.ray.time = 0.0f;
-    rh.ray.mask = 0xFFFFFFFFu;
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(rtcScene, &context, &rh);
-    return rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+    return intersectRay(rtcScene, origin, dir, rh);
 }
 
 bool ReferenceBaker::Impl::occluded(const glm::vec3& origin, const glm::vec3& dir, float tfar) const {
