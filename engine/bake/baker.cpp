@@ -653,16 +653,14 @@ Status Baker::Impl::init(const Scene& scene) {
         const int width = halfWidth / k;
         noiseWeights = gl::Texture::create2DArray("noise estimate: half-size texels' weights", GL_RGBA16F, width, width, pages);
         std::vector<glm::vec4> weights(size_t(width) * width * size_t(pages), glm::vec4(1.0f, 0.0f, 0.0f, 0.0f));
-        for (int p = 0; p < pages && k == 2; ++p) {
-            const TexelQuarters quarters = texelQuarters(mesh, charts, p, outputRes);
-            for (int y = 0; y < width; ++y)
-                for (int x = 0; x < width; ++x) {
-                    const int ox = x * stats.noiseStride, oy = y * stats.noiseStride;
-                    if (ox < outputRes && oy < outputRes)
+        if (k == 2)
+            for (int p = 0; p < pages; ++p) {
+                const TexelQuarters quarters = texelQuarters(mesh, charts, p, outputRes);
+                for (int y = 0; y * stats.noiseStride < outputRes; ++y)
+                    for (int x = 0; x * stats.noiseStride < outputRes; ++x)
                         weights[(size_t(p) * width + size_t(y)) * width + size_t(x)] =
-                            quarters.weights[size_t(oy) * outputRes + size_t(ox)];
-                }
-        }
+                            quarters.weights[size_t(y * stats.noiseStride) * outputRes + size_t(x * stats.noiseStride)];
+            }
         gl::writeTexture(noiseWeights.id(), 0, 0, 0, width, width, pages, GL_RGBA, GL_FLOAT, 16, weights.data());
     }
     const uint32_t zero[4] = {0, 0, 0, 0};

@@ -20,19 +20,6 @@ namespace {
 
 constexpr double PI = 3.14159265358979323846;
 
-// splitmix64 (Steele, Lea, Flood 2014): a small seeded stream, enough for the
-// three numbers of one rotation.
-struct SplitMix64 {
-    uint64_t state;
-    uint64_t next() {
-        const uint64_t z = mix64(state);  // the finalizer of state + the golden gamma
-        state += 0x9E3779B97F4A7C15ull;
-        return z;
-    }
-    // [0, 1) with 53 bits
-    double uniform() { return double(next() >> 11) * 0x1.0p-53; }
-};
-
 // Base-2 radical inverse (van der Corput) of i as a 32-bit fraction: i's bits
 // mirrored, so the value is reverseBits(i) / 2^32 in [0, 1).
 uint32_t reverseBits(uint32_t i) {

@@ -2,23 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
+#include "core/hash.h"
 #include "reference/embree_mesh.h"
 
 namespace bb {
 namespace {
 
 constexpr int kBounces = 5;
-
-uint64_t splitmix(uint64_t& state) {
-    uint64_t z = (state += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
-
-float uniform(uint64_t& state) { return float(splitmix(state) >> 40) * (1.0f / 16777216.0f); }
 
 struct Triangle {
     glm::vec3 p0, e1, e2;
@@ -59,19 +50,13 @@ double transportAlbedo(const BakeMesh& mesh, const std::vector<glm::vec3>& albed
         return 0.0;
     }
 
-    // the ray offset: a millionth of the scene's extent past the surface
-    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-    for (const BakeVertex& v : mesh.vertices) {
-        lo = glm::min(lo, glm::vec3(v.position));
-        hi = glm::max(hi, glm::vec3(v.position));
-    }
-    const float offset = 1e-5f * std::max(1e-3f, glm::length(hi - lo));
+    const float offset = rayOffset(mesh);
 
     std::vector<glm::dvec3> sums(kBounces + 1, glm::dvec3(0.0));  // E_k x paths, k = 0..kBounces
-    uint64_t rng = 0x5eed5eedull;
+    SplitMix64 rng{0x5eed5eedull};
     for (int p = 0; p < paths; ++p) {
         // a point by area, then k cosine rays
-        const double pick = (double(p) + double(uniform(rng))) / double(paths) * area;
+        const double pick = (double(p) + double(rng.uniformFloat())) / double(paths) * area;
         size_t t = size_t(std::lower_bound(cdf.begin(), cdf.end(), pick) - cdf.begin());
         t = std::min(t, n - 1);
         bool flip = false;  // on a double-sided triangle's back
@@ -79,7 +64,7 @@ double transportAlbedo(const BakeMesh& mesh, const std::vector<glm::vec3>& albed
         for (int k = 0; k <= kBounces; ++k) {
             const Triangle& tri = tris[t];
             const glm::vec3 normal = flip ? -tri.n : tri.n;
-            float u = uniform(rng), v = uniform(rng);
+            float u = rng.uniformFloat(), v = rng.uniformFloat();
             if (u + v > 1.0f) {
                 u = 1.0f - u;
                 v = 1.0f - v;
@@ -88,8 +73,8 @@ double transportAlbedo(const BakeMesh& mesh, const std::vector<glm::vec3>& albed
             weight *= albedo[mesh.triangles[t].material];
             sums[size_t(k)] += glm::dvec3(weight);
             if (k == kBounces) break;
-            // cosine direction about tri.n
-            const float r = std::sqrt(uniform(rng)), phi = 6.28318531f * uniform(rng);
+            // a cosine direction about the normal
+            const float r = std::sqrt(rng.uniformFloat()), phi = 6.28318531f * rng.uniformFloat();
             const glm::vec3 axis = std::abs(normal.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
             const glm::vec3 tx = glm::normalize(glm::cross(axis, normal)), ty = glm::cross(normal, tx);
             const glm::vec3 dir = r * std::cos(phi) * tx + r * std::sin(phi) * ty +

@@ -15,4 +15,18 @@ inline uint64_t mix64(uint64_t x) {
 inline uint64_t hash(uint64_t a, uint64_t b) { return mix64(a ^ mix64(b)); }
 inline uint64_t hash(uint64_t a, uint64_t b, uint64_t c) { return hash(hash(a, b), c); }
 
+// splitmix64 (Steele, Lea, Flood 2014): a small seeded stream.
+struct SplitMix64 {
+    uint64_t state;
+    uint64_t next() {
+        const uint64_t z = mix64(state);  // the finalizer of state + the golden gamma
+        state += 0x9E3779B97F4A7C15ull;
+        return z;
+    }
+    // [0, 1) with 53 bits
+    double uniform() { return double(next() >> 11) * 0x1.0p-53; }
+    // [0, 1) with 24 bits (a float's, never rounded up to 1)
+    float uniformFloat() { return float(next() >> 40) * 0x1.0p-24f; }
+};
+
 }  // namespace bb

@@ -1,5 +1,7 @@
 #include "reference/embree_mesh.h"
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace bb {
@@ -35,6 +37,13 @@ RTCScene commitBakeMeshScene(RTCDevice device, const BakeMesh& mesh, RTCBuildQua
         return nullptr;
     }
     return scene;
+}
+
+float rayOffset(const BakeMesh& mesh) {
+    const Bounds& b = mesh.bounds;
+    const float extent = std::max({std::fabs(b.min.x), std::fabs(b.min.y), std::fabs(b.min.z), std::fabs(b.max.x),
+                                   std::fabs(b.max.y), std::fabs(b.max.z), glm::length(b.size())});
+    return std::max(2e-5f * extent, 1e-7f);
 }
 
 bool intersectRay(RTCScene scene, const glm::vec3& origin, const glm::vec3& dir, RTCRayHit& rh) {

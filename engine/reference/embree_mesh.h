@@ -14,6 +14,10 @@ namespace bb {
 // Embree fails (the device's error function says why).
 RTCScene commitBakeMeshScene(RTCDevice device, const BakeMesh& mesh, RTCBuildQuality quality);
 
+// How far a ray starts off its surface: a few hundred float ulps at the
+// mesh's largest (local) coordinate or its diagonal, whichever is larger.
+float rayOffset(const BakeMesh& mesh);
+
 // The nearest hit from `origin` along `dir` (tnear 0, no tfar); false: none.
 bool intersectRay(RTCScene scene, const glm::vec3& origin, const glm::vec3& dir, RTCRayHit& rh);
 

@@ -273,11 +273,7 @@ Status ReferenceBaker::Impl::init(const Scene& scene) {
     stats.threads = options.threads;
     stats.lightmapTexels = int64_t(layout.texelCount());
 
-    // offsets: a few hundred float ulps at the scene's largest (local) coordinate
-    float extent = std::max({std::fabs(mesh.bounds.min.x), std::fabs(mesh.bounds.min.y), std::fabs(mesh.bounds.min.z),
-                             std::fabs(mesh.bounds.max.x), std::fabs(mesh.bounds.max.y), std::fabs(mesh.bounds.max.z),
-                             glm::length(mesh.bounds.size())});
-    eps = std::max(2e-5f * extent, 1e-7f);
+    eps = rayOffset(mesh);
 
     // triangles: geometric normals and the emitter distribution
     const size_t n = mesh.triangles.size();
