@@ -242,14 +242,13 @@ void Baker::Impl::uploadMaterials(const Scene& scene) {
         glTextureParameteri(tex.id(), GL_TEXTURE_WRAP_T, GL_REPEAT);
         materialTextures.push_back(std::move(tex));
     }
-    // triangles of each page sorted by material: one draw per (page, material) run
-    std::vector<uint32_t> order(mesh.triangles.size());
-    std::iota(order.begin(), order.end(), 0u);
-    std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
-        const auto& ta = mesh.triangles[a];
-        const auto& tb = mesh.triangles[b];
-        return ta.page != tb.page ? ta.page < tb.page : ta.material < tb.material;
-    });
+    // each page's triangles in pageDrawOrder (by material): one draw per (page, material) run
+    std::vector<uint32_t> order;
+    order.reserve(mesh.triangles.size());
+    for (int p = 0; p < layout.pageCount; ++p) {
+        const std::vector<uint32_t> page = pageDrawOrder(mesh, p);
+        order.insert(order.end(), page.begin(), page.end());
+    }
     std::vector<uint32_t> indices;
     indices.reserve(order.size() * 3);
     for (size_t i = 0; i < order.size(); ++i) {
@@ -302,12 +301,18 @@ void Baker::Impl::drawSurface(GLuint program, bool materialUniforms) {
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
 }
 
+std::vector<int32_t> Baker::Impl::bakeTexelOwners(int page, std::vector<uint8_t>* partial) const {
+    if (options.supersample == 1) return texelOwners(mesh, page, layout.resolution, partial);
+    CHECK_EQ(options.supersample, 2);
+    return halfTexelOwners(mesh, charts, page, outputLayout.resolution, partial);
+}
+
 void Baker::Impl::uploadPartialPoints() {
     const int res = layout.resolution;
     std::vector<BakeVertex> points;
     for (int p = 0; p < layout.pageCount; ++p) {
         std::vector<uint8_t> partial;
-        const std::vector<int32_t> owners = texelOwners(mesh, p, res, &partial, minPartialArea());
+        const std::vector<int32_t> owners = bakeTexelOwners(p, &partial);
         std::vector<std::pair<uint32_t, BakeVertex>> page;  // (material, point)
         for (size_t i = 0; i < owners.size(); ++i) {
             if (!partial[i]) continue;
@@ -369,7 +374,7 @@ void Baker::Impl::coveragePass() {
     for (int p = 0; p < layout.pageCount; ++p) {
         gl::readTexture(dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, codes.data());
         std::vector<uint8_t> partial;
-        const std::vector<int32_t> owners = texelOwners(mesh, p, res, &partial, minPartialArea());
+        const std::vector<int32_t> owners = bakeTexelOwners(p, &partial);
         const std::vector<TexelFootprint> footprints = texelFootprints(mesh, p, res, owners, charts);
         curved[size_t(p)] = curvedTexels(mesh, p, res, owners, charts, partial, footprints);
         std::erase_if(curved[size_t(p)], [&](const CurvedTexel& c) {

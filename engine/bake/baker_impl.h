@@ -72,8 +72,8 @@ struct Baker::Impl {
     // p + backLayerOffset (13 more bytes a texel; the direct light stays front-only).
     gl::Texture accum, radiance, direct, dilation, chartNeighbours, readModes, footprint, texelCharts;
     int backLayerOffset = 0;  // 0: no double-sided triangles, one layer per page
-    // texelOwners' threshold for partial texels: a quarter of it for half-size texels (bake/supersample.h)
-    double minPartialArea() const { return kMinPartialTexelArea / double(options.supersample * options.supersample); }
+    // page p's texel owners: texelOwners, or a supersampled bake's halfTexelOwners
+    std::vector<int32_t> bakeTexelOwners(int page, std::vector<uint8_t>* partial) const;
     int stateLayers() const { return layout.pageCount + backLayerOffset; }  // accum's and radiance's layers
     // The bundle and update programs handle back sides only when built with it:
     // llvmpipe runs even a uniformly skipped branch's texture fetch (25 % of the bundle pass)

@@ -21,7 +21,7 @@ TexelQuarters texelQuarters(const BakeMesh& mesh, const std::vector<uint32_t>& c
     TexelQuarters out;
     out.owner = texelOwners(mesh, page, res);
     const std::vector<TexelFootprint> footprints = texelFootprints(mesh, page, res, out.owner, charts);
-    const std::vector<int32_t> fineOwner = texelOwners(mesh, page, 2 * res, nullptr, kMinPartialTexelArea / 4.0);
+    const std::vector<int32_t> fineOwner = halfTexelOwners(mesh, charts, page, res);
     const size_t perPage = size_t(res) * res;
     out.area.resize(perPage);
     out.weights.assign(perPage, glm::vec4(0.0f));

@@ -5,18 +5,17 @@
 // A texel's value is the mean over its footprint, the part of its square on
 // its chart (docs/design-notes.md "Texels partly on their chart"): the mean
 // of its four half-size texels' values, each weighted by the part of the
-// texel's footprint in its quarter (TexelFootprint::quarters), over those the
-// fine bake baked on the texel's own chart. Where charts share a texel (an
-// asset's atlas packed tighter than its texels) a quarter another chart holds
-// is not this one's (their values differ as a roof's from a wall's); a
-// quarter with less than a sixteenth of its square on the chart is padding
-// there and left out. A texel no quarter is left of (a sliver a few
-// hundredths of it wide, or a chart whose part of the texel other charts
-// hold) takes its chart's covered neighbours' mean (LightmapPages::
+// texel's footprint in its quarter (TexelFootprint::quarters). Where charts
+// share a texel (an asset's atlas packed tighter than its texels) the fine
+// bake gives a half-size texel to the chart of the texel it lies in wherever
+// that chart holds a sixteenth of its square (halfTexelOwners): the texel's
+// whole footprint is baked on its chart. A quarter with less than that is
+// left out, and a texel no quarter is left of (a sliver a few hundredths of
+// it wide) takes its chart's covered neighbours' mean (LightmapPages::
 // filledTexels), and without one is padding (lostTexels; the bake warns): the
 // bench city's own atlas, whose generator packs strips several to a texel,
-// has 27 and 374 of 16442, the living room 36 and 0 of 99616. Coverage is
-// the layout's own (texelOwners, as the reference's), and the padding is
+// has none of either (before halfTexelOwners 27 and 374 of 16442). Coverage
+// is the layout's own (texelOwners, as the reference's), and the padding is
 // dilated again (dilatedImage below).
 //
 // Why: the bounced light a texel reads is its neighbours' means, and a mean

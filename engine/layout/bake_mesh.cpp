@@ -128,8 +128,10 @@ std::vector<uint32_t> findLightmapCharts(const BakeMesh& mesh) {
 std::vector<uint32_t> pageDrawOrder(const BakeMesh& mesh, int page) {
     std::vector<uint32_t> order(mesh.pageFirstTriangle[size_t(page) + 1] - mesh.pageFirstTriangle[size_t(page)]);
     std::iota(order.begin(), order.end(), mesh.pageFirstTriangle[size_t(page)]);
-    std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
-        return mesh.triangles[a].material < mesh.triangles[b].material;
+    const auto built = [&](uint32_t t) { return mesh.builtIndex.empty() ? t : mesh.builtIndex[t]; };
+    std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+        const uint32_t ma = mesh.triangles[a].material, mb = mesh.triangles[b].material;
+        return ma != mb ? ma < mb : built(a) < built(b);
     });
     return order;
 }
@@ -201,6 +203,39 @@ std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res, std::v
         if (isPartial[i] && !(total[i] >= minPartialArea)) {
             owner[i] = -1;
             isPartial[i] = 0;
+        }
+    if (partial) *partial = std::move(isPartial);
+    return owner;
+}
+
+std::vector<int32_t> halfTexelOwners(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res,
+                                     std::vector<uint8_t>* partial) {
+    const std::vector<int32_t> coarse = texelOwners(mesh, page, res);
+    std::vector<uint8_t> isPartial;
+    std::vector<int32_t> owner = texelOwners(mesh, page, 2 * res, &isPartial, kMinPartialTexelArea / 4.0);
+    const int fineRes = 2 * res;
+    std::vector<double> best(owner.size(), 0.0), total(owner.size(), 0.0);
+    std::vector<int32_t> taken(owner.size(), -1);
+    for (uint32_t t : pageDrawOrder(mesh, page)) {
+        glm::dvec2 q[3];
+        const double absArea = pageCorners(mesh, t, fineRes, q);
+        if (absArea == 0.0 || !std::isfinite(absArea)) continue;
+        forTexelsUnder(q, fineRes, [&](int x, int y, size_t i) {
+            const int32_t c = coarse[size_t(y / 2) * size_t(res) + size_t(x / 2)];
+            if (c < 0 || charts[size_t(c)] != charts[t]) return;
+            if (owner[i] >= 0 && charts[size_t(owner[i])] == charts[t]) return;
+            const double area = polygonArea(squareOnTriangle(q, x, y));
+            if (!(area > 0.0)) return;
+            total[i] += area;
+            if (!(area >= best[i])) return;
+            best[i] = area;
+            taken[i] = int32_t(t);
+        });
+    }
+    for (size_t i = 0; i < owner.size(); ++i)
+        if (taken[i] >= 0 && total[i] >= kMinPartialTexelArea / 4.0) {
+            owner[i] = taken[i];
+            isPartial[i] = 1;
         }
     if (partial) *partial = std::move(isPartial);
     return owner;
@@ -534,6 +569,8 @@ BakeMesh buildBakeMesh(const Scene& scene, const Layout& layout) {
 
     BakeMesh out;
     out.triangles.resize(first[pageCount]);
+    out.builtIndex.resize(first[pageCount]);
+    std::iota(out.builtIndex.begin(), out.builtIndex.end(), 0u);
     out.vertices.resize(size_t(first[pageCount]) * 3);
     std::vector<uint32_t> cursor(first.begin(), first.end() - 1);
 

@@ -40,6 +40,11 @@ struct BakeMesh {
     std::vector<BakeVertex> vertices;     // 3 per triangle, not shared (simple, and normals may differ)
     std::vector<BakeTriangle> triangles;
     std::vector<uint32_t> pageFirstTriangle;  // triangles are sorted by page; page p is [first[p], first[p+1])
+    // Per triangle, its index as buildBakeMesh wrote it. Whoever reorders the
+    // triangles (the bake's clusters, tiler/tiler.h) moves it with them, so
+    // that pageDrawOrder, and with it which triangle owns a texel where two
+    // tie, is the same in every consumer's mesh. Empty: the triangles' order.
+    std::vector<uint32_t> builtIndex;
     Bounds bounds;            // of the positions (local space)
     glm::dvec3 origin{0.0};   // Scene::origin: world = position + origin (directions are the same in both)
     size_t triangleCount() const { return triangles.size(); }
@@ -61,7 +66,9 @@ BakeMesh buildBakeMesh(const Scene& scene, const Layout& layout);
 // from one source vertex). Returns a chart id per triangle.
 std::vector<uint32_t> findLightmapCharts(const BakeMesh& mesh);
 
-// Page `page`'s triangles in the GPU meta pass's draw order (by material, stable).
+// Page `page`'s triangles in the GPU meta pass's draw order: by material,
+// then by BakeMesh::builtIndex (not by the mesh's order, which the bake's
+// clusters change and the reference's does not).
 std::vector<uint32_t> pageDrawOrder(const BakeMesh& mesh, int page);
 
 // Triangle t's corners in page space, in texels of a res x res page, counter-
@@ -90,6 +97,19 @@ double pageCorners(const BakeMesh& mesh, uint32_t t, int res, glm::dvec2 (&q)[3]
 constexpr double kMinPartialTexelArea = 0.25;
 std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res, std::vector<uint8_t>* partial = nullptr,
                                  double minPartialArea = kMinPartialTexelArea);
+
+// The owners of a supersampled bake's half-size texels (bake/supersample.h):
+// texelOwners at 2 res with a quarter of kMinPartialTexelArea, except that a
+// half-size texel holding a sixteenth of its square or more of its texel's
+// chart (texelOwners' owner at res, by `charts`) belongs to that chart: to
+// the chart's triangle holding the most of it, as a partial texel. The
+// texel's value is its quarters' values on its chart; a quarter another
+// chart took held a part of the footprint no half-size texel baked, and where
+// the light changes across the texel (a roof's edge under a taller
+// neighbour, 0.97 to 0.62 in a fifth of a texel) the texel read the rest's
+// mean, 8 % bright on the bench city.
+std::vector<int32_t> halfTexelOwners(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res,
+                                     std::vector<uint8_t>* partial = nullptr);
 
 // Which parts of each texel's square lie on its chart (the chart of its owner,
 // texelOwners): bit 8 j + i for the cell [i/8, (i+1)/8) x [j/8, (j+1)/8) of the

@@ -172,12 +172,15 @@ std::vector<Cluster> clusterMesh(BakeMesh& mesh, uint32_t maxTriangles) {
     // reorder triangles and vertices
     std::vector<BakeTriangle> triangles(n);
     std::vector<BakeVertex> vertices(3 * n);
+    std::vector<uint32_t> built(mesh.builtIndex.size());
     for (size_t i = 0; i < n; ++i) {
         triangles[i] = mesh.triangles[order[i]];
         for (int k = 0; k < 3; ++k) vertices[3 * i + k] = mesh.vertices[3 * size_t(order[i]) + k];
+        if (!built.empty()) built[i] = mesh.builtIndex[order[i]];
     }
     mesh.triangles = std::move(triangles);
     mesh.vertices = std::move(vertices);
+    mesh.builtIndex = std::move(built);
 
     std::vector<Cluster> clusters;
     clusters.reserve(ranges.size());
@@ -205,6 +208,7 @@ void setClusterImportance(BakeMesh& mesh, std::vector<Cluster>& clusters, std::v
     std::vector<BakeTriangle> triangles;
     std::vector<BakeVertex> vertices;
     std::vector<float> values;
+    std::vector<uint32_t> built;
     for (const Cluster& cluster : clusters) {
         order.resize(cluster.count);
         std::iota(order.begin(), order.end(), cluster.first);
@@ -229,14 +233,17 @@ void setClusterImportance(BakeMesh& mesh, std::vector<Cluster>& clusters, std::v
         triangles.clear();
         vertices.clear();
         values.clear();
+        built.clear();
         for (uint32_t t : order) {
             triangles.push_back(mesh.triangles[t]);
             for (int k = 0; k < 3; ++k) vertices.push_back(mesh.vertices[3 * size_t(t) + k]);
             values.push_back(importance[t]);
+            if (!mesh.builtIndex.empty()) built.push_back(mesh.builtIndex[t]);
         }
         std::copy(triangles.begin(), triangles.end(), mesh.triangles.begin() + cluster.first);
         std::copy(vertices.begin(), vertices.end(), mesh.vertices.begin() + 3 * size_t(cluster.first));
         std::copy(values.begin(), values.end(), importance.begin() + cluster.first);
+        std::copy(built.begin(), built.end(), mesh.builtIndex.begin() + cluster.first);
 
         // runs [first, first + count): receivers first, then the triangles that only occlude
         Cluster c = cluster;

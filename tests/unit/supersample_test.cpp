@@ -11,7 +11,8 @@ namespace {
 // Two charts on an 8 x 8 page (texel units): A over x 1..4.6, y 1..5, and B
 // over x 4.6..7, y 1..6 (its left edge's ends are not A's: another chart).
 // Texel (4, 2) is A's (its centre 4.5 is on A): 0.6 of its square, the left
-// quarters whole and a fifth of the right ones, whose half-size texels B owns.
+// quarters whole and a fifth of the right ones, whose half-size texels'
+// centres are on B.
 BakeMesh twoCharts() {
     BakeMesh m;
     auto quad = [&](glm::vec2 a, glm::vec2 b) {
@@ -59,7 +60,7 @@ TEST(Supersample, ATexelIsItsChartsHalfSizeTexelsWeightedByItsFootprint) {
     // the fine bake: A's half-size texels read their x, B's 100 more
     LightmapPages fine;
     fine.resolution = 16;
-    const std::vector<int32_t> fineOwners = texelOwners(mesh, 0, 16, nullptr, kMinPartialTexelArea / 4.0);
+    const std::vector<int32_t> fineOwners = halfTexelOwners(mesh, charts, 0, 8);
     io::ImageRgb img;
     img.width = img.height = 16;
     img.pixels.resize(256);
@@ -71,13 +72,20 @@ TEST(Supersample, ATexelIsItsChartsHalfSizeTexelsWeightedByItsFootprint) {
     }
     fine.pages.push_back(img);
     fine.covered.push_back(covered);
-    ASSERT_EQ(charts[size_t(fineOwners[4 * 16 + 9])], charts[2]) << "B owns the right quarters' half-size texels";
+    // the right quarters' half-size texels hold 0.2 of their squares of A: A's, as texel (4, 2) is
+    const std::vector<int32_t> centreOwners = texelOwners(mesh, 0, 16, nullptr, kMinPartialTexelArea / 4.0);
+    ASSERT_EQ(charts[size_t(centreOwners[4 * 16 + 9])], charts[2]) << "their centres are on B";
+    EXPECT_EQ(charts[size_t(fineOwners[4 * 16 + 9])], charts[0]);
+    EXPECT_EQ(charts[size_t(fineOwners[5 * 16 + 9])], charts[0]);
+    EXPECT_EQ(charts[size_t(fineOwners[4 * 16 + 10])], charts[2]) << "B's own texel (5, 2) keeps its half-size texels";
 
     const LightmapPages out = reduceLightmaps(fine, mesh, charts, layout);
     ASSERT_EQ(out.resolution, 8);
     EXPECT_EQ(out.filledTexels, 0);
     EXPECT_FLOAT_EQ(out.pages[0].pixels[2 * 8 + 2].x, 4.5f) << "a whole texel: the mean of its four";
-    EXPECT_FLOAT_EQ(out.pages[0].pixels[t].x, 8.0f) << "A's part only, not B's right quarters";
+    // A's part: the left quarters (x 8) whole, the right ones (x 9) by their 48 of 256 footprint points;
+    // a fine bake that gave the right quarters to B read 8, its left part's mean alone
+    EXPECT_FLOAT_EQ(out.pages[0].pixels[t].x, (8.0f * 512.0f + 9.0f * 96.0f) / 608.0f);
     EXPECT_TRUE(out.covered[0][t]);
     EXPECT_NEAR(out.area[0][t] / 255.0, 0.6, 0.01);
     // B's texel (5, 2): B's half-size texels 10 and 11
