@@ -214,29 +214,91 @@ std::vector<int32_t> halfTexelOwners(const BakeMesh& mesh, const std::vector<uin
     std::vector<uint8_t> isPartial;
     std::vector<int32_t> owner = texelOwners(mesh, page, 2 * res, &isPartial, kMinPartialTexelArea / 4.0);
     const int fineRes = 2 * res;
-    std::vector<double> best(owner.size(), 0.0), total(owner.size(), 0.0);
-    std::vector<int32_t> taken(owner.size(), -1);
-    for (uint32_t t : pageDrawOrder(mesh, page)) {
+    const double minArea = kMinPartialTexelArea / 4.0;
+    const std::vector<uint32_t> order = pageDrawOrder(mesh, page);
+    // the half-size texels two or more charts lie in (the others have nothing to decide)
+    constexpr uint32_t kNone = UINT32_MAX, kMany = UINT32_MAX - 1;
+    std::vector<uint32_t> seen(owner.size(), kNone);
+    for (uint32_t t : order) {
+        glm::dvec2 q[3];
+        const double absArea = pageCorners(mesh, t, fineRes, q);
+        if (absArea == 0.0 || !std::isfinite(absArea)) continue;
+        forTexelsUnder(q, fineRes, [&](int, int, size_t i) {
+            if (seen[i] == kNone) seen[i] = charts[t];
+            else if (seen[i] != charts[t]) seen[i] = kMany;
+        });
+    }
+    // their charts' parts: area, and the triangle holding the most of it (the last in draw order of equals)
+    struct Part {
+        size_t texel;
+        uint32_t chart, triangle;
+        double area, best;
+    };
+    std::vector<Part> parts;
+    for (uint32_t t : order) {
         glm::dvec2 q[3];
         const double absArea = pageCorners(mesh, t, fineRes, q);
         if (absArea == 0.0 || !std::isfinite(absArea)) continue;
         forTexelsUnder(q, fineRes, [&](int x, int y, size_t i) {
-            const int32_t c = coarse[size_t(y / 2) * size_t(res) + size_t(x / 2)];
-            if (c < 0 || charts[size_t(c)] != charts[t]) return;
-            if (owner[i] >= 0 && charts[size_t(owner[i])] == charts[t]) return;
+            if (seen[i] != kMany) return;
             const double area = polygonArea(squareOnTriangle(q, x, y));
-            if (!(area > 0.0)) return;
-            total[i] += area;
-            if (!(area >= best[i])) return;
-            best[i] = area;
-            taken[i] = int32_t(t);
+            if (area > 0.0) parts.push_back({i, charts[t], t, area, area});
         });
     }
-    for (size_t i = 0; i < owner.size(); ++i)
-        if (taken[i] >= 0 && total[i] >= kMinPartialTexelArea / 4.0) {
-            owner[i] = taken[i];
-            isPartial[i] = 1;
+    std::stable_sort(parts.begin(), parts.end(), [](const Part& a, const Part& b) {
+        return a.texel != b.texel ? a.texel < b.texel : a.chart < b.chart;
+    });
+    size_t merged = 0;
+    for (size_t k = 0; k < parts.size(); ++k) {
+        if (merged > 0 && parts[merged - 1].texel == parts[k].texel && parts[merged - 1].chart == parts[k].chart) {
+            Part& m = parts[merged - 1];
+            m.area += parts[k].area;
+            if (parts[k].best >= m.best) m.best = parts[k].best, m.triangle = parts[k].triangle;
+        } else {
+            parts[merged++] = parts[k];
         }
+    }
+    parts.resize(merged);
+    auto chartOf = [&](size_t i) { return owner[i] < 0 ? kNone : charts[size_t(owner[i])]; };
+    auto texelChart = [&](size_t i) {  // the chart of the texel half-size texel i lies in
+        const int32_t c = coarse[(i / size_t(fineRes)) / 2 * size_t(res) + (i % size_t(fineRes)) / 2];
+        return c < 0 ? kNone : charts[size_t(c)];
+    };
+    auto take = [&](const Part& p) {
+        owner[p.texel] = int32_t(p.triangle);
+        isPartial[p.texel] = 1;
+    };
+    // (1) the texel's chart, wherever it holds a sixteenth of the half-size texel
+    for (const Part& p : parts)
+        if (p.chart == texelChart(p.texel) && chartOf(p.texel) != p.chart && p.area >= minArea) take(p);
+    // (2) the half-size texels no texel's value needs (not their texel's chart's) go to the
+    // charts lying in them that own none of the 3 x 3 around them, largest part first, while
+    // the chart they are taken from keeps another there: every strip's bundle fragments
+    // find a texel of their own to read (append.frag ownTexel), not another chart's light
+    auto ownsNear = [&](size_t i, uint32_t chart, bool besides) {
+        const int x = int(i % size_t(fineRes)), y = int(i / size_t(fineRes));
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const int qx = x + dx, qy = y + dy;
+                if ((besides && dx == 0 && dy == 0) || qx < 0 || qy < 0 || qx >= fineRes || qy >= fineRes) continue;
+                if (chartOf(size_t(qy) * size_t(fineRes) + size_t(qx)) == chart) return true;
+            }
+        return false;
+    };
+    std::vector<const Part*> wanting;
+    for (const Part& p : parts)
+        if (p.area >= minArea && chartOf(p.texel) != texelChart(p.texel) && p.chart != texelChart(p.texel) &&
+            !ownsNear(p.texel, p.chart, false))
+            wanting.push_back(&p);
+    std::stable_sort(wanting.begin(), wanting.end(), [](const Part* a, const Part* b) { return a->area > b->area; });
+    std::vector<uint8_t> given(owner.size(), 0);
+    for (const Part* p : wanting) {
+        const uint32_t from = chartOf(p->texel);
+        if (given[p->texel] || ownsNear(p->texel, p->chart, false)) continue;
+        if (from != kNone && !ownsNear(p->texel, from, true)) continue;
+        take(*p);
+        given[p->texel] = 1;
+    }
     if (partial) *partial = std::move(isPartial);
     return owner;
 }

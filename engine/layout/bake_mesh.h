@@ -107,7 +107,13 @@ std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res, std::v
 // chart took held a part of the footprint no half-size texel baked, and where
 // the light changes across the texel (a roof's edge under a taller
 // neighbour, 0.97 to 0.62 in a fifth of a texel) the texel read the rest's
-// mean, 8 % bright on the bench city.
+// mean, 8 % bright on the bench city. The half-size texels no texel's value
+// needs (their chart is not their texel's) then go, largest part first, to
+// charts lying in them (a sixteenth or more) that own none of the 3 x 3
+// around them, while the chart they are taken from keeps one there: a strip
+// that loses every texel it lies in to wider charts (286 of the bench city's
+// 1680) gets texels of its own, and its bundle fragments read its light, not
+// the band's beside it (append.frag ownTexel).
 std::vector<int32_t> halfTexelOwners(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res,
                                      std::vector<uint8_t>* partial = nullptr);
 

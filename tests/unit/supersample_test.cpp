@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "bake/supersample.h"
+#include "support/page_meshes.h"
 
 namespace bb {
 namespace {
@@ -15,23 +16,8 @@ namespace {
 // centres are on B.
 BakeMesh twoCharts() {
     BakeMesh m;
-    auto quad = [&](glm::vec2 a, glm::vec2 b) {
-        const glm::vec2 p00 = a, p10(b.x, a.y), p11 = b, p01(a.x, b.y);
-        const std::pair<std::array<glm::vec2, 3>, uint32_t> tris[2] = {{{p00, p10, p11}, 1u | 4u},
-                                                                      {{p00, p11, p01}, 1u | 2u}};
-        for (const auto& [corners, borders] : tris) {
-            for (const glm::vec2& c : corners) {
-                BakeVertex v;
-                v.position = glm::vec4(c, 0, 1);
-                v.normal = glm::vec4(0, 0, 1, 0);
-                v.lightmapUv = c / 8.0f;
-                m.vertices.push_back(v);
-            }
-            m.triangles.push_back({0, 0, 0, borders * TRIANGLE_CHART_BORDER0});
-        }
-    };
-    quad({1.0f, 1.0f}, {4.6f, 5.0f});
-    quad({4.6f, 1.0f}, {7.0f, 6.0f});
+    addPageQuad(m, {1.0f, 1.0f}, {4.6f, 5.0f}, 8.0f);
+    addPageQuad(m, {4.6f, 1.0f}, {7.0f, 6.0f}, 8.0f);
     m.pageFirstTriangle = {0, 4};
     return m;
 }

@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "layout/bake_mesh.h"
+#include "support/page_meshes.h"
 
 namespace bb {
 namespace {
@@ -18,18 +19,8 @@ namespace {
 BakeMesh stripMesh() {
     BakeMesh m;
     const glm::vec2 o0(2, 5.455f), o1(6, 5.455f), w0(2, 5.555f), w1(6, 5.555f);
-    // (corners, border edges: bit k for the edge opposite corner k)
-    const std::pair<std::array<glm::vec2, 3>, uint32_t> tris[2] = {{{o0, o1, w1}, 1u | 4u}, {{o0, w1, w0}, 1u | 2u}};
-    for (const auto& [corners, borders] : tris) {
-        for (const glm::vec2& c : corners) {
-            BakeVertex v;
-            v.position = glm::vec4(c, 0, 1);
-            v.normal = glm::vec4(0, 0, 1, 0);
-            v.lightmapUv = c / 16.0f;
-            m.vertices.push_back(v);
-        }
-        m.triangles.push_back({0, 0, 0, borders * TRIANGLE_CHART_BORDER0});
-    }
+    addPageTriangle(m, {o0, o1, w1}, 16.0f, 0.0f, 1u | 4u);
+    addPageTriangle(m, {o0, w1, w0}, 16.0f, 0.0f, 1u | 2u);
     m.pageFirstTriangle = {0, 2};
     return m;
 }

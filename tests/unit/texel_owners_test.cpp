@@ -7,6 +7,7 @@
 #include <array>
 
 #include "layout/bake_mesh.h"
+#include "support/page_meshes.h"
 #include "tiler/tiler.h"
 
 namespace bb {
@@ -18,24 +19,9 @@ namespace {
 // generated building's ledge top and the soffit above it were in its atlas.
 BakeMesh mirroredStrips() {
     BakeMesh m;
-    auto quad = [&](float v0, float v1, float z) {
-        const glm::vec2 p00(2, v0), p10(6, v0), p11(6, v1), p01(2, v1);
-        const std::array<glm::vec2, 3> tris[2] = {{p00, p10, p11}, {p00, p11, p01}};
-        for (const auto& corners : tris) {
-            for (const glm::vec2& c : corners) {
-                BakeVertex v;
-                v.position = glm::vec4(c, z, 1);
-                v.normal = glm::vec4(0, 0, 1, 0);
-                v.lightmapUv = c / 16.0f;
-                m.vertices.push_back(v);
-            }
-            m.triangles.push_back({0, 0, 0, 0});
-        }
-    };
-    quad(5.3f, 5.425f, 0.0f);
-    quad(5.675f, 5.8f, 1.0f);
+    addPageQuad(m, {2.0f, 5.3f}, {6.0f, 5.425f}, 16.0f, 0.0f);
+    addPageQuad(m, {2.0f, 5.675f}, {6.0f, 5.8f}, 16.0f, 1.0f);
     m.pageFirstTriangle = {0, 4};
-    m.builtIndex = {0, 1, 2, 3};
     return m;
 }
 
@@ -74,19 +60,10 @@ TEST(TexelOwners, TiesGoTheSameWayWhateverOrderTheMeshHolds) {
 TEST(TexelOwners, ClustersCarryTheBuiltIndex) {
     BakeMesh m;
     for (int k = 0; k < 40; ++k) {  // triangles scattered so that the median splits reorder them
-        const float x = float((k * 17) % 40), y = float((k * 7) % 5);
-        for (const glm::vec2 c : {glm::vec2(x, y), glm::vec2(x + 0.5f, y), glm::vec2(x, y + 0.5f)}) {
-            BakeVertex v;
-            v.position = glm::vec4(c, float(k), 1);
-            v.normal = glm::vec4(0, 0, 1, 0);
-            v.lightmapUv = c / 64.0f;
-            m.vertices.push_back(v);
-        }
-        m.triangles.push_back({0, 0, 0, 0});
+        const glm::vec2 c(float((k * 17) % 40), float((k * 7) % 5));
+        addPageTriangle(m, {c, c + glm::vec2(0.5f, 0.0f), c + glm::vec2(0.0f, 0.5f)}, 64.0f, float(k));
     }
     m.pageFirstTriangle = {0, 40};
-    m.builtIndex.resize(40);
-    for (uint32_t k = 0; k < 40; ++k) m.builtIndex[k] = k;
     std::vector<Cluster> clusters = clusterMesh(m, 8);
     std::vector<float> importance(40);
     for (size_t t = 0; t < 40; ++t) importance[t] = float((m.builtIndex[t] * 13) % 40) + (t % 3 == 0 ? 0.0f : 100.0f);
@@ -97,6 +74,52 @@ TEST(TexelOwners, ClustersCarryTheBuiltIndex) {
         moved += m.builtIndex[t] != t;
     }
     EXPECT_GT(moved, 0) << "the clusters reordered the triangles";
+}
+
+// Three charts across an 8 x 8 page (texel units), x 1..7: A below (y 1..3.2),
+// a strip B 0.12 high (y 3.3..3.42, a soffit between two bands) and C above
+// (y 3.5..6). Texel row 3 is C's (its centres on C's bottom edge); of its
+// lower half-size row (y 3..3.5) A holds 0.4 and B 0.24 of each, and A's
+// triangles the most, so B would own no half-size texel anywhere and its
+// bundle fragments would read A's light.
+BakeMesh threeBands() {
+    BakeMesh m;
+    addPageQuad(m, {1.0f, 1.0f}, {7.0f, 3.2f}, 8.0f);
+    addPageQuad(m, {1.0f, 3.3f}, {7.0f, 3.42f}, 8.0f);
+    addPageQuad(m, {1.0f, 3.5f}, {7.0f, 6.0f}, 8.0f);
+    m.pageFirstTriangle = {0, 6};
+    return m;
+}
+
+TEST(HalfTexelOwners, AStripThatLosesEveryHalfSizeTexelGetsOnesNoTexelNeeds) {
+    const BakeMesh m = threeBands();
+    const std::vector<uint32_t> charts = findLightmapCharts(m);
+    const uint32_t a = charts[0], b = charts[2], c = charts[4];
+    ASSERT_TRUE(a != b && b != c && a != c);
+    const std::vector<int32_t> coarse = texelOwners(m, 0, 8);
+    ASSERT_EQ(charts[size_t(coarse[3 * 8 + 3])], c) << "row 3 is C's";
+    const std::vector<int32_t> plain = texelOwners(m, 0, 16, nullptr, kMinPartialTexelArea / 4.0);
+    const std::vector<int32_t> fine = halfTexelOwners(m, charts, 0, 8);
+    // the half-size texels of row 6 (y 3..3.5), x 2..13, with one of B's within one of them
+    auto nearB = [&](const std::vector<int32_t>& owner) {
+        int n = 0;
+        for (int x = 2; x <= 13; ++x) {
+            bool near = false;
+            for (int dx = -1; dx <= 1; ++dx) {
+                const int32_t o = owner[6 * 16 + size_t(x + dx)];
+                near |= o >= 0 && charts[size_t(o)] == b;
+            }
+            n += near;
+        }
+        return n;
+    };
+    EXPECT_LE(nearB(plain), 3) << "by the most area B owns at most an end's: the test can fail";
+    EXPECT_EQ(nearB(fine), 12);
+    // A keeps the row below (its own texels' half-size texels), C its texels' upper half: no texel's value moves
+    for (int x = 2; x <= 13; ++x) {
+        EXPECT_EQ(charts[size_t(fine[5 * 16 + size_t(x)])], a) << x;
+        EXPECT_EQ(charts[size_t(fine[7 * 16 + size_t(x)])], c) << x;
+    }
 }
 
 }  // namespace
