@@ -215,19 +215,23 @@ std::vector<int32_t> halfTexelOwners(const BakeMesh& mesh, const std::vector<uin
     std::vector<int32_t> owner = texelOwners(mesh, page, 2 * res, &isPartial, kMinPartialTexelArea / 4.0);
     const int fineRes = 2 * res;
     const double minArea = kMinPartialTexelArea / 4.0;
+    // f(t, q, x, y, i) for each triangle t in draw order (q: its corners) and half-size texel under its bounds
     const std::vector<uint32_t> order = pageDrawOrder(mesh, page);
+    auto forHalfTexelsUnderTriangles = [&](auto&& f) {
+        for (uint32_t t : order) {
+            glm::dvec2 q[3];
+            const double absArea = pageCorners(mesh, t, fineRes, q);
+            if (absArea == 0.0 || !std::isfinite(absArea)) continue;
+            forTexelsUnder(q, fineRes, [&](int x, int y, size_t i) { f(t, q, x, y, i); });
+        }
+    };
     // the half-size texels two or more charts lie in (the others have nothing to decide)
     constexpr uint32_t kNone = UINT32_MAX, kMany = UINT32_MAX - 1;
     std::vector<uint32_t> seen(owner.size(), kNone);
-    for (uint32_t t : order) {
-        glm::dvec2 q[3];
-        const double absArea = pageCorners(mesh, t, fineRes, q);
-        if (absArea == 0.0 || !std::isfinite(absArea)) continue;
-        forTexelsUnder(q, fineRes, [&](int, int, size_t i) {
-            if (seen[i] == kNone) seen[i] = charts[t];
-            else if (seen[i] != charts[t]) seen[i] = kMany;
-        });
-    }
+    forHalfTexelsUnderTriangles([&](uint32_t t, const glm::dvec2(&)[3], int, int, size_t i) {
+        if (seen[i] == kNone) seen[i] = charts[t];
+        else if (seen[i] != charts[t]) seen[i] = kMany;
+    });
     // their charts' parts: area, and the triangle holding the most of it (the last in draw order of equals)
     struct Part {
         size_t texel;
@@ -235,16 +239,11 @@ std::vector<int32_t> halfTexelOwners(const BakeMesh& mesh, const std::vector<uin
         double area, best;
     };
     std::vector<Part> parts;
-    for (uint32_t t : order) {
-        glm::dvec2 q[3];
-        const double absArea = pageCorners(mesh, t, fineRes, q);
-        if (absArea == 0.0 || !std::isfinite(absArea)) continue;
-        forTexelsUnder(q, fineRes, [&](int x, int y, size_t i) {
-            if (seen[i] != kMany) return;
-            const double area = polygonArea(squareOnTriangle(q, x, y));
-            if (area > 0.0) parts.push_back({i, charts[t], t, area, area});
-        });
-    }
+    forHalfTexelsUnderTriangles([&](uint32_t t, const glm::dvec2(&q)[3], int x, int y, size_t i) {
+        if (seen[i] != kMany) return;
+        const double area = polygonArea(squareOnTriangle(q, x, y));
+        if (area > 0.0) parts.push_back({i, charts[t], t, area, area});
+    });
     std::stable_sort(parts.begin(), parts.end(), [](const Part& a, const Part& b) {
         return a.texel != b.texel ? a.texel < b.texel : a.chart < b.chart;
     });

@@ -243,7 +243,7 @@ void setClusterImportance(BakeMesh& mesh, std::vector<Cluster>& clusters, std::v
         std::copy(triangles.begin(), triangles.end(), mesh.triangles.begin() + cluster.first);
         std::copy(vertices.begin(), vertices.end(), mesh.vertices.begin() + 3 * size_t(cluster.first));
         std::copy(values.begin(), values.end(), importance.begin() + cluster.first);
-        std::copy(built.begin(), built.end(), mesh.builtIndex.begin() + cluster.first);
+        if (!built.empty()) std::copy(built.begin(), built.end(), mesh.builtIndex.begin() + cluster.first);
 
         // runs [first, first + count): receivers first, then the triangles that only occlude
         Cluster c = cluster;
