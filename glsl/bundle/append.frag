@@ -60,20 +60,25 @@ vec3 axisOffset(uint mode, vec3 l, vec3 m, vec3 r, float x) {
 // The texel whose radiance a fragment of chart `chart` reads at texel position
 // t (page texels minus 1/2): the nearest, c, unless another chart owns it
 // (charts closer than a texel: its light is the other chart's surface's, a
-// wall's seen on the sill beside it), then the nearest of the three next to c
-// toward t that the fragment's own chart owns; c where none is.
+// wall's seen on the sill beside it), then of the eight around c that the
+// fragment's own chart owns the one whose square lies nearest t; c where none
+// is. Only the three toward t were searched before: past the middle of a
+// texel another chart owns, away from its own (a wall's last fifth of a texel
+// under a soffit, the texels above a strip's), none is, and the fragment read
+// the other chart's light (the city's own atlas: soffits twice too bright).
 ivec2 ownTexel(vec2 t, ivec2 c, ivec2 size, int page, uint chart) {
     if ((texelFetch(texelCharts, ivec3(c, page), 0).r & TEXEL_CHART_MASK) == chart) return c;
-    vec2 f = t - vec2(c);
-    ivec2 toward = ivec2(f.x < 0.0 ? -1 : 1, f.y < 0.0 ? -1 : 1);
-    bool alongX = abs(f.x) >= abs(f.y);  // the step along x brings the centre nearer than along y
-    ivec2 order[3] = ivec2[3](alongX ? ivec2(toward.x, 0) : ivec2(0, toward.y),
-                              alongX ? ivec2(0, toward.y) : ivec2(toward.x, 0), toward);
-    for (int k = 0; k < 3; ++k) {
-        ivec2 n = clamp(c + order[k], ivec2(0), size - 1);
-        if ((texelFetch(texelCharts, ivec3(n, page), 0).r & TEXEL_CHART_MASK) == chart) return n;
-    }
-    return c;
+    ivec2 best = c;
+    float bestDistance = 3.0e38;
+    for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+            ivec2 n = clamp(c + ivec2(dx, dy), ivec2(0), size - 1);
+            if (n == c || (texelFetch(texelCharts, ivec3(n, page), 0).r & TEXEL_CHART_MASK) != chart) continue;
+            vec2 e = clamp(t, vec2(n) - 0.5, vec2(n) + 0.5) - t;  // from t to n's square
+            float d = dot(e, e);
+            if (d < bestDistance) bestDistance = d, best = n;
+        }
+    return best;
 }
 
 // Outgoing radiance where a fragment of chart `chart` lands, light-map
