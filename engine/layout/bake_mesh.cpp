@@ -225,14 +225,9 @@ std::vector<int32_t> halfTexelOwners(const BakeMesh& mesh, const std::vector<uin
             forTexelsUnder(q, fineRes, [&](int x, int y, size_t i) { f(t, q, x, y, i); });
         }
     };
-    // the half-size texels two or more charts lie in (the others have nothing to decide)
-    constexpr uint32_t kNone = UINT32_MAX, kMany = UINT32_MAX - 1;
-    std::vector<uint32_t> seen(owner.size(), kNone);
-    forHalfTexelsUnderTriangles([&](uint32_t t, const glm::dvec2(&)[3], int, int, size_t i) {
-        if (seen[i] == kNone) seen[i] = charts[t];
-        else if (seen[i] != charts[t]) seen[i] = kMany;
-    });
-    // their charts' parts: area, and the triangle holding the most of it (the last in draw order of equals)
+    constexpr uint32_t kNone = UINT32_MAX;
+    // each chart's part of each half-size texel: area, and the triangle holding the most of it (the last
+    // in draw order of equals)
     struct Part {
         size_t texel;
         uint32_t chart, triangle;
@@ -240,7 +235,6 @@ std::vector<int32_t> halfTexelOwners(const BakeMesh& mesh, const std::vector<uin
     };
     std::vector<Part> parts;
     forHalfTexelsUnderTriangles([&](uint32_t t, const glm::dvec2(&q)[3], int x, int y, size_t i) {
-        if (seen[i] != kMany) return;
         const double area = polygonArea(squareOnTriangle(q, x, y));
         if (area > 0.0) parts.push_back({i, charts[t], t, area, area});
     });
@@ -295,6 +289,41 @@ std::vector<int32_t> halfTexelOwners(const BakeMesh& mesh, const std::vector<uin
         const uint32_t from = chartOf(p->texel);
         if (given[p->texel] || ownsNear(p->texel, p->chart, false)) continue;
         if (from != kNone && !ownsNear(p->texel, from, true)) continue;
+        take(*p);
+        given[p->texel] = 1;
+    }
+    // (3) charts still owning none near a half-size texel they lie in take it from its texel's
+    // chart where that chart keeps at least as much of the texel's footprint in its other
+    // quarters, the smallest loss first: the texel's value then leaves that part of its
+    // footprint out, where the strip's light read from another chart's texel was that chart's
+    // (a setback's top in an alley between two buildings read the roof parapet's that owns its
+    // texels, and the alley's walls beside it read twice too bright)
+    auto areaOf = [&](size_t i, uint32_t chart) {  // chart's part of half-size texel i
+        auto it = std::lower_bound(parts.begin(), parts.end(), std::make_pair(i, chart), [](const Part& a, const auto& key) {
+            return a.texel != key.first ? a.texel < key.first : a.chart < key.second;
+        });
+        return it != parts.end() && it->texel == i && it->chart == chart ? it->area : 0.0;
+    };
+    auto keptShare = [&](size_t i) {  // of the texel's footprint in its quarters on its chart, the share outside i
+        const int x = int(i % size_t(fineRes)) / 2 * 2, y = int(i / size_t(fineRes)) / 2 * 2;
+        const uint32_t chart = texelChart(i);
+        double kept = 0.0;
+        for (int q = 0; q < 4; ++q) {
+            const size_t j = size_t(y + q / 2) * size_t(fineRes) + size_t(x + q % 2);
+            if (j != i && chartOf(j) == chart) kept += areaOf(j, chart);
+        }
+        const double lost = areaOf(i, chart);
+        return kept + lost > 0.0 ? kept / (kept + lost) : 0.0;
+    };
+    std::vector<std::pair<double, const Part*>> takeable;
+    for (const Part& p : parts)
+        if (p.area >= minArea && p.chart != texelChart(p.texel) && chartOf(p.texel) == texelChart(p.texel) &&
+            !ownsNear(p.texel, p.chart, false))
+            takeable.push_back({keptShare(p.texel), &p});
+    std::stable_sort(takeable.begin(), takeable.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    for (const auto& [kept, p] : takeable) {
+        if (kept < 0.5) break;
+        if (given[p->texel] || ownsNear(p->texel, p->chart, false) || keptShare(p->texel) < 0.5) continue;
         take(*p);
         given[p->texel] = 1;
     }

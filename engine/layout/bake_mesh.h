@@ -113,7 +113,10 @@ std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res, std::v
 // around them, while the chart they are taken from keeps one there: a strip
 // that loses every texel it lies in to wider charts (286 of the bench city's
 // 1680) gets texels of its own, and its bundle fragments read its light, not
-// the band's beside it (append.frag ownTexel).
+// the band's beside it (append.frag ownTexel). Charts still owning none near a
+// half-size texel they lie in then take it from its texel's chart, the
+// smallest loss first, where that chart keeps at least half its part of the
+// texel in the other quarters (the texel's value leaves the rest out).
 std::vector<int32_t> halfTexelOwners(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res,
                                      std::vector<uint8_t>* partial = nullptr);
 

@@ -122,5 +122,38 @@ TEST(HalfTexelOwners, AStripThatLosesEveryHalfSizeTexelGetsOnesNoTexelNeeds) {
     }
 }
 
+// A strip B (y 3.78..3.9, x 1..7 of an 8 x 8 page) lying only in half-size
+// row 7 (y 3.5..4), which texel row 3's chart C (y 3.2..3.6, its centres on
+// C) needs: C holds a fifth of it (a sixteenth is enough), 0.6 of row 6 below.
+// No half-size texel is free for B (D, y 3.92..6, owns rows 8 and up): B
+// takes some of row 7 from C, which keeps row 6, three quarters of its part.
+TEST(HalfTexelOwners, AStripWithNoFreeHalfSizeTexelTakesOnesItsTexelsChartCanSpare) {
+    BakeMesh m;
+    addPageQuad(m, {1.0f, 3.2f}, {7.0f, 3.6f}, 8.0f);
+    addPageQuad(m, {1.0f, 3.78f}, {7.0f, 3.9f}, 8.0f);
+    addPageQuad(m, {1.0f, 3.92f}, {7.0f, 6.0f}, 8.0f);
+    m.pageFirstTriangle = {0, 6};
+    const std::vector<uint32_t> charts = findLightmapCharts(m);
+    const uint32_t c = charts[0], b = charts[2];
+    ASSERT_NE(b, c);
+    ASSERT_EQ(charts[size_t(texelOwners(m, 0, 8)[3 * 8 + 3])], c) << "row 3 is C's";
+    const std::vector<int32_t> fine = halfTexelOwners(m, charts, 0, 8);
+    int nearB = 0;
+    for (int x = 3; x <= 12; ++x) {
+        bool near = false;
+        for (int dx = -1; dx <= 1; ++dx) {
+            const int32_t o = fine[7 * 16 + size_t(x + dx)];
+            near |= o >= 0 && charts[size_t(o)] == b;
+        }
+        nearB += near;
+        EXPECT_EQ(charts[size_t(fine[6 * 16 + size_t(x)])], c) << "C keeps row 6, x " << x;
+    }
+    EXPECT_EQ(nearB, 10) << "a half-size texel of B's within one of each of row 7's";
+    for (int x = 2; x <= 13; ++x) {
+        const int32_t o = fine[7 * 16 + size_t(x)];
+        EXPECT_TRUE(o >= 0 && (charts[size_t(o)] == b || charts[size_t(o)] == c)) << x;
+    }
+}
+
 }  // namespace
 }  // namespace bb
