@@ -74,5 +74,52 @@ TEST(SharedTexelReads, AChartReadsNoLightOfAnotherChartSharingItsTexels) {
     EXPECT_EQ(brightest, 0.0f) << "the receiver sees light that the black strip read from the emitter's texels";
 }
 
+// Supersampled (2): a black strip B (page rows 2..5.35, facing +z) ends in
+// texel row 5, whose centre lies on an emitter C (rows 5.45..8, facing -z, Le
+// 10). C holds a tenth of half-size row 10 (5..5.5) and takes it (a texel's
+// half-size texels go to its chart), though B holds 0.7 of it and its centre.
+// B's fragments past that centre (5.25..5.35) lie nearer row 11 (C's) than
+// row 9 (B's own): searching only the texels toward the fragment they found
+// none of B's and read C's Le. A black receiver R sees B and C's back only.
+TEST(SharedTexelReads, AFragmentPastTheMiddleOfAnotherChartsTexelReadsItsOwnChartsTexelBehind) {
+    BB_REQUIRE_GL();
+    const int res = 32;
+    Scene scene;
+    const int emitter = addMaterial(scene, glm::vec3(0.0f), glm::vec3(10.0f));
+    const int black = addMaterial(scene, glm::vec3(0.0f));
+    const int b = addQuad(scene, glm::vec3(0.0f, 0.0f, 0.0f), glm::vec3(0.5f, 0.0f, 0.0f),
+                          glm::vec3(0.0f, 0.3f, 0.0f), black, "strip");
+    const int c = addQuad(scene, glm::vec3(0.0f, 0.8f, 0.0f), glm::vec3(0.5f, 0.0f, 0.0f),
+                          glm::vec3(0.0f, -0.2f, 0.0f), emitter, "emitter");
+    const int r = addQuad(scene, glm::vec3(0.0f, 0.0f, 0.3f), glm::vec3(0.8f, 0.0f, 0.0f),
+                          glm::vec3(0.0f, -0.8f, 0.0f), black, "receiver");
+    placeUv(scene, b, {2.0f, 2.0f}, {15.0f, 5.35f}, res);
+    placeUv(scene, c, {2.0f, 5.45f}, {15.0f, 8.0f}, res);
+    placeUv(scene, r, {2.0f, 17.0f}, {30.0f, 30.0f}, res);
+    auto layout = computeLayout(scene, assetLayout(res));
+    ASSERT_TRUE(layout) << layout.error();
+    BakeOptions options;
+    options.directions = 128;
+    options.directLight = BakeOptions::DirectLight::Bundles;
+    options.supersample = 2;
+    auto maps = bakeGpu(scene, *layout, options);
+    ASSERT_TRUE(maps) << maps.error();
+
+    float brightest = 0.0f;
+    int receiverTexels = 0;
+    for (int y = 17; y < 30; ++y)
+        for (int x = 2; x < 30; ++x) {
+            const size_t i = size_t(y) * res + x;
+            if (!maps->covered[0][i]) continue;
+            ++receiverTexels;
+            const auto& v = maps->pages[0].pixels[i];
+            brightest = std::max({brightest, v.r, v.g, v.b});
+        }
+    std::printf("[shared texel reads, past the middle] receiver: %d texels, brightest L_lm %.6f (exact: 0)\n",
+                receiverTexels, brightest);
+    ASSERT_GT(receiverTexels, 300);
+    EXPECT_EQ(brightest, 0.0f) << "the receiver sees light the black strip read from the emitter's texel";
+}
+
 }  // namespace
 }  // namespace bb::test
