@@ -32,6 +32,22 @@ void placeUv(Scene& scene, int instance, glm::vec2 lo, glm::vec2 hi, int res) {
         uv = (lo + (hi - lo) * uv) / float(res);
 }
 
+// The brightest channel of the covered texels of page 0 in [2, 30) x [17, 30)
+// (the receiver's rectangle in both tests), and how many those are.
+float brightestReceiverTexel(const LightmapPages& maps, int res, int* covered) {
+    float brightest = 0.0f;
+    *covered = 0;
+    for (int y = 17; y < 30; ++y)
+        for (int x = 2; x < 30; ++x) {
+            const size_t i = size_t(y) * res + x;
+            if (!maps.covered[0][i]) continue;
+            ++*covered;
+            const auto& c = maps.pages[0].pixels[i];
+            brightest = std::max({brightest, c.r, c.g, c.b});
+        }
+    return brightest;
+}
+
 TEST(SharedTexelReads, AChartReadsNoLightOfAnotherChartSharingItsTexels) {
     BB_REQUIRE_GL();
     const int res = 32;
@@ -58,16 +74,8 @@ TEST(SharedTexelReads, AChartReadsNoLightOfAnotherChartSharingItsTexels) {
     ASSERT_TRUE(maps) << maps.error();
     EXPECT_GT(stats.sharedTexels, 0) << "E and B must share the column of texels between them";
 
-    float brightest = 0.0f;
     int receiverTexels = 0;
-    for (int y = 17; y < 30; ++y)
-        for (int x = 2; x < 30; ++x) {
-            const size_t i = size_t(y) * res + x;
-            if (!maps->covered[0][i]) continue;
-            ++receiverTexels;
-            const auto& c = maps->pages[0].pixels[i];
-            brightest = std::max({brightest, c.r, c.g, c.b});
-        }
+    const float brightest = brightestReceiverTexel(*maps, res, &receiverTexels);
     std::printf("[shared texel reads] %lld shared texels; receiver: %d texels, brightest L_lm %.6f (exact: 0)\n",
                 static_cast<long long>(stats.sharedTexels), receiverTexels, brightest);
     ASSERT_GT(receiverTexels, 300);
@@ -105,16 +113,8 @@ TEST(SharedTexelReads, AFragmentPastTheMiddleOfAnotherChartsTexelReadsItsOwnChar
     auto maps = bakeGpu(scene, *layout, options);
     ASSERT_TRUE(maps) << maps.error();
 
-    float brightest = 0.0f;
     int receiverTexels = 0;
-    for (int y = 17; y < 30; ++y)
-        for (int x = 2; x < 30; ++x) {
-            const size_t i = size_t(y) * res + x;
-            if (!maps->covered[0][i]) continue;
-            ++receiverTexels;
-            const auto& v = maps->pages[0].pixels[i];
-            brightest = std::max({brightest, v.r, v.g, v.b});
-        }
+    const float brightest = brightestReceiverTexel(*maps, res, &receiverTexels);
     std::printf("[shared texel reads, past the middle] receiver: %d texels, brightest L_lm %.6f (exact: 0)\n",
                 receiverTexels, brightest);
     ASSERT_GT(receiverTexels, 300);
