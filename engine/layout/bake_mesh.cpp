@@ -225,18 +225,27 @@ std::vector<int32_t> halfTexelOwners(const BakeMesh& mesh, const std::vector<uin
             forTexelsUnder(q, fineRes, [&](int x, int y, size_t i) { f(t, q, x, y, i); });
         }
     };
-    constexpr uint32_t kNone = UINT32_MAX;
-    // each chart's part of each half-size texel: area, and the triangle holding the most of it (the last
-    // in draw order of equals)
+    // the half-size texels two or more charts lie in (the others have little to decide)
+    constexpr uint32_t kNone = UINT32_MAX, kMany = UINT32_MAX - 1;
+    std::vector<uint32_t> seen(owner.size(), kNone);
+    forHalfTexelsUnderTriangles([&](uint32_t t, const glm::dvec2(&)[3], int, int, size_t i) {
+        if (seen[i] == kNone) seen[i] = charts[t];
+        else if (seen[i] != charts[t]) seen[i] = kMany;
+    });
+    // their charts' parts: area, and the triangle holding the most of it (the last in draw order of
+    // equals); the others' one chart's area
     struct Part {
         size_t texel;
         uint32_t chart, triangle;
         double area, best;
     };
     std::vector<Part> parts;
+    std::vector<double> soleArea(owner.size(), 0.0);
     forHalfTexelsUnderTriangles([&](uint32_t t, const glm::dvec2(&q)[3], int x, int y, size_t i) {
         const double area = polygonArea(squareOnTriangle(q, x, y));
-        if (area > 0.0) parts.push_back({i, charts[t], t, area, area});
+        if (!(area > 0.0)) return;
+        if (seen[i] == kMany) parts.push_back({i, charts[t], t, area, area});
+        else soleArea[i] += area;
     });
     std::stable_sort(parts.begin(), parts.end(), [](const Part& a, const Part& b) {
         return a.texel != b.texel ? a.texel < b.texel : a.chart < b.chart;
@@ -299,6 +308,7 @@ std::vector<int32_t> halfTexelOwners(const BakeMesh& mesh, const std::vector<uin
     // (a setback's top in an alley between two buildings read the roof parapet's that owns its
     // texels, and the alley's walls beside it read twice too bright)
     auto areaOf = [&](size_t i, uint32_t chart) {  // chart's part of half-size texel i
+        if (seen[i] != kMany) return seen[i] == chart ? soleArea[i] : 0.0;
         auto it = std::lower_bound(parts.begin(), parts.end(), std::make_pair(i, chart), [](const Part& a, const auto& key) {
             return a.texel != key.first ? a.texel < key.first : a.chart < key.second;
         });
