@@ -287,19 +287,24 @@ std::vector<int32_t> halfTexelOwners(const BakeMesh& mesh, const std::vector<uin
             }
         return false;
     };
+    // a strip's part: a sixteenth or more, its chart not the texel's and owning none of the 3 x 3 around
+    auto stripPart = [&](const Part& p) {
+        return p.area >= minArea && p.chart != texelChart(p.texel) && !ownsNear(p.texel, p.chart, false);
+    };
     std::vector<const Part*> wanting;
     for (const Part& p : parts)
-        if (p.area >= minArea && chartOf(p.texel) != texelChart(p.texel) && p.chart != texelChart(p.texel) &&
-            !ownsNear(p.texel, p.chart, false))
-            wanting.push_back(&p);
+        if (stripPart(p) && chartOf(p.texel) != texelChart(p.texel)) wanting.push_back(&p);
     std::stable_sort(wanting.begin(), wanting.end(), [](const Part* a, const Part* b) { return a->area > b->area; });
     std::vector<uint8_t> given(owner.size(), 0);
+    auto give = [&](const Part& p) {
+        take(p);
+        given[p.texel] = 1;
+    };
     for (const Part* p : wanting) {
         const uint32_t from = chartOf(p->texel);
         if (given[p->texel] || ownsNear(p->texel, p->chart, false)) continue;
         if (from != kNone && !ownsNear(p->texel, from, true)) continue;
-        take(*p);
-        given[p->texel] = 1;
+        give(*p);
     }
     // (3) charts still owning none near a half-size texel they lie in take it from its texel's
     // chart where that chart keeps at least as much of the texel's footprint in its other
@@ -309,9 +314,10 @@ std::vector<int32_t> halfTexelOwners(const BakeMesh& mesh, const std::vector<uin
     // texels, and the alley's walls beside it read twice too bright)
     auto areaOf = [&](size_t i, uint32_t chart) {  // chart's part of half-size texel i
         if (seen[i] != kMany) return seen[i] == chart ? soleArea[i] : 0.0;
-        auto it = std::lower_bound(parts.begin(), parts.end(), std::make_pair(i, chart), [](const Part& a, const auto& key) {
-            return a.texel != key.first ? a.texel < key.first : a.chart < key.second;
-        });
+        auto it = std::lower_bound(parts.begin(), parts.end(), std::make_pair(i, chart),
+                                   [](const Part& a, const auto& key) {
+                                       return a.texel != key.first ? a.texel < key.first : a.chart < key.second;
+                                   });
         return it != parts.end() && it->texel == i && it->chart == chart ? it->area : 0.0;
     };
     auto keptShare = [&](size_t i) {  // of the texel's footprint in its quarters on its chart, the share outside i
@@ -327,15 +333,12 @@ std::vector<int32_t> halfTexelOwners(const BakeMesh& mesh, const std::vector<uin
     };
     std::vector<std::pair<double, const Part*>> takeable;
     for (const Part& p : parts)
-        if (p.area >= minArea && p.chart != texelChart(p.texel) && chartOf(p.texel) == texelChart(p.texel) &&
-            !ownsNear(p.texel, p.chart, false))
-            takeable.push_back({keptShare(p.texel), &p});
+        if (stripPart(p) && chartOf(p.texel) == texelChart(p.texel)) takeable.push_back({keptShare(p.texel), &p});
     std::stable_sort(takeable.begin(), takeable.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
     for (const auto& [kept, p] : takeable) {
         if (kept < 0.5) break;
         if (given[p->texel] || ownsNear(p->texel, p->chart, false) || keptShare(p->texel) < 0.5) continue;
-        take(*p);
-        given[p->texel] = 1;
+        give(*p);
     }
     if (partial) *partial = std::move(isPartial);
     return owner;

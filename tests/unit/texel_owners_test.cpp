@@ -76,6 +76,22 @@ TEST(TexelOwners, ClustersCarryTheBuiltIndex) {
     EXPECT_GT(moved, 0) << "the clusters reordered the triangles";
 }
 
+// Of half-size row `row` (a 16-wide page), x0..x1, how many have a half-size
+// texel of `chart` within one along the row.
+int ownedWithinOne(const std::vector<int32_t>& owner, const std::vector<uint32_t>& charts, uint32_t chart, int row,
+                   int x0, int x1) {
+    int n = 0;
+    for (int x = x0; x <= x1; ++x) {
+        bool near = false;
+        for (int dx = -1; dx <= 1; ++dx) {
+            const int32_t o = owner[size_t(row) * 16 + size_t(x + dx)];
+            near |= o >= 0 && charts[size_t(o)] == chart;
+        }
+        n += near;
+    }
+    return n;
+}
+
 // Three charts across an 8 x 8 page (texel units), x 1..7: A below (y 1..3.2),
 // a strip B 0.12 high (y 3.3..3.42, a soffit between two bands) and C above
 // (y 3.5..6). Texel row 3 is C's (its centres on C's bottom edge); of its
@@ -101,20 +117,9 @@ TEST(HalfTexelOwners, AStripThatLosesEveryHalfSizeTexelGetsOnesNoTexelNeeds) {
     const std::vector<int32_t> plain = texelOwners(m, 0, 16, nullptr, kMinPartialTexelArea / 4.0);
     const std::vector<int32_t> fine = halfTexelOwners(m, charts, 0, 8);
     // the half-size texels of row 6 (y 3..3.5), x 2..13, with one of B's within one of them
-    auto nearB = [&](const std::vector<int32_t>& owner) {
-        int n = 0;
-        for (int x = 2; x <= 13; ++x) {
-            bool near = false;
-            for (int dx = -1; dx <= 1; ++dx) {
-                const int32_t o = owner[6 * 16 + size_t(x + dx)];
-                near |= o >= 0 && charts[size_t(o)] == b;
-            }
-            n += near;
-        }
-        return n;
-    };
-    EXPECT_LE(nearB(plain), 3) << "by the most area B owns at most an end's: the test can fail";
-    EXPECT_EQ(nearB(fine), 12);
+    EXPECT_LE(ownedWithinOne(plain, charts, b, 6, 2, 13), 3)
+        << "by the most area B owns at most an end's: the test can fail";
+    EXPECT_EQ(ownedWithinOne(fine, charts, b, 6, 2, 13), 12);
     // A keeps the row below (its own texels' half-size texels), C its texels' upper half: no texel's value moves
     for (int x = 2; x <= 13; ++x) {
         EXPECT_EQ(charts[size_t(fine[5 * 16 + size_t(x)])], a) << x;
@@ -138,17 +143,9 @@ TEST(HalfTexelOwners, AStripWithNoFreeHalfSizeTexelTakesOnesItsTexelsChartCanSpa
     ASSERT_NE(b, c);
     ASSERT_EQ(charts[size_t(texelOwners(m, 0, 8)[3 * 8 + 3])], c) << "row 3 is C's";
     const std::vector<int32_t> fine = halfTexelOwners(m, charts, 0, 8);
-    int nearB = 0;
-    for (int x = 3; x <= 12; ++x) {
-        bool near = false;
-        for (int dx = -1; dx <= 1; ++dx) {
-            const int32_t o = fine[7 * 16 + size_t(x + dx)];
-            near |= o >= 0 && charts[size_t(o)] == b;
-        }
-        nearB += near;
-        EXPECT_EQ(charts[size_t(fine[6 * 16 + size_t(x)])], c) << "C keeps row 6, x " << x;
-    }
-    EXPECT_EQ(nearB, 10) << "a half-size texel of B's within one of each of row 7's";
+    for (int x = 3; x <= 12; ++x) EXPECT_EQ(charts[size_t(fine[6 * 16 + size_t(x)])], c) << "C keeps row 6, x " << x;
+    EXPECT_EQ(ownedWithinOne(fine, charts, b, 7, 3, 12), 10)
+        << "a half-size texel of B's within one of each of row 7's";
     for (int x = 2; x <= 13; ++x) {
         const int32_t o = fine[7 * 16 + size_t(x)];
         EXPECT_TRUE(o >= 0 && (charts[size_t(o)] == b || charts[size_t(o)] == c)) << x;
