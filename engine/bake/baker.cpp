@@ -302,9 +302,7 @@ void Baker::Impl::drawSurface(GLuint program, bool materialUniforms) {
 }
 
 std::vector<int32_t> Baker::Impl::bakeTexelOwners(int page, std::vector<uint8_t>* partial) const {
-    if (options.supersample == 1) return texelOwners(mesh, page, layout.resolution, partial);
-    CHECK_EQ(options.supersample, 2);
-    return halfTexelOwners(mesh, charts, page, outputLayout.resolution, partial);
+    return fineTexelOwners(mesh, charts, page, outputLayout.resolution, options.supersample, partial);
 }
 
 void Baker::Impl::uploadPartialPoints() {
@@ -654,19 +652,20 @@ Status Baker::Impl::init(const Scene& scene) {
         halfAccum = gl::Texture::create2DArray("noise estimate: odd directions' accumulators", GL_RG32UI, halfWidth,
                                                halfWidth, pages);
         noiseTerms = gl::Texture::create2DArray("noise estimate terms", GL_RGBA32F, halfWidth / k, halfWidth / k, pages);
-        // the sampled texels' half-size texels' weights (the reduction's: texelQuarters); whole texels weigh 1
-        const int width = halfWidth / k;
-        noiseWeights = gl::Texture::create2DArray("noise estimate: half-size texels' weights", GL_RGBA16F, width, width, pages);
-        std::vector<glm::vec4> weights(size_t(width) * width * size_t(pages), glm::vec4(1.0f, 0.0f, 0.0f, 0.0f));
-        if (k == 2)
-            for (int p = 0; p < pages; ++p) {
-                const TexelQuarters quarters = texelQuarters(mesh, charts, p, outputRes);
-                for (int y = 0; y * stats.noiseStride < outputRes; ++y)
-                    for (int x = 0; x * stats.noiseStride < outputRes; ++x)
-                        weights[(size_t(p) * width + size_t(y)) * width + size_t(x)] =
-                            quarters.weights[size_t(y * stats.noiseStride) * outputRes + size_t(x * stats.noiseStride)];
-            }
-        gl::writeTexture(noiseWeights.id(), 0, 0, 0, width, width, pages, GL_RGBA, GL_FLOAT, 16, weights.data());
+        // the sampled texels' half-size texels' weights (the reduction's: fineTexelWeights)
+        noiseWeights = gl::Texture::create2DArray("noise estimate: half-size texels' weights", GL_R16F, halfWidth, halfWidth, pages);
+        std::vector<float> weights(size_t(halfWidth) * halfWidth * size_t(pages), 0.0f);
+        for (int p = 0; p < pages; ++p) {
+            const std::vector<float> fine = fineTexelWeights(mesh, charts, p, outputRes, k);
+            for (int y = 0; y < halfWidth; ++y)
+                for (int x = 0; x < halfWidth; ++x) {
+                    const int fx = x / k * stats.noiseStride * k + x % k, fy = y / k * stats.noiseStride * k + y % k;
+                    if (fx < k * outputRes && fy < k * outputRes)
+                        weights[(size_t(p) * halfWidth + size_t(y)) * halfWidth + size_t(x)] =
+                            fine[size_t(fy) * size_t(k * outputRes) + size_t(fx)];
+                }
+        }
+        gl::writeTexture(noiseWeights.id(), 0, 0, 0, halfWidth, halfWidth, pages, GL_RED, GL_FLOAT, 4, weights.data());
     }
     const uint32_t zero[4] = {0, 0, 0, 0};
     clearAccumulators();
@@ -799,13 +798,14 @@ Baker::~Baker() = default;
 
 Expected<std::unique_ptr<Baker>> Baker::create(const Scene& scene, const Layout& layout, const BakeOptions& options) {
     auto impl = std::make_unique<Impl>();
-    if (options.supersample < 0 || options.supersample > 2)
-        return Status::error("supersample must be 0 (auto), 1 or 2, not " + std::to_string(options.supersample));
+    if (options.supersample < 0 || options.supersample > 4 || options.supersample == 3)
+        return Status::error("supersample must be 0 (auto), 1, 2 or 4, not " + std::to_string(options.supersample));
     impl->options = options;
     int& k = impl->options.supersample;
-    constexpr int64_t kMaxStateBytesPerTexel = 46;  // light-map state with double-sided materials
-    if (k == 0)
-        k = int64_t(layout.texelCount()) * 4 * kMaxStateBytesPerTexel <= options.memoryBudget / 2 && layout.resolution <= 8192 ? 2 : 1;
+    if (k == 0) {
+        const BakeMesh mesh = buildBakeMesh(scene, layout);
+        k = autoSupersample(mesh, findLightmapCharts(mesh), layout, options.memoryBudget);
+    }
     impl->stats.supersample = k;
     impl->outputLayout = layout;
     impl->layout = k > 1 ? supersampledLayout(layout, k) : layout;

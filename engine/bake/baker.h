@@ -91,9 +91,10 @@ struct BakeOptions {
     // 2: bake every light map texel as 2 x 2 half-size ones and reduce them to
     // it, each weighted by its part of the texel's footprint (bake/supersample.h):
     // the bounced light is read at twice the resolution. 4x the texels and
-    // light-map state, about 2x the time. 1: texels as laid out. 0: 2 when
-    // the light-map state at 4x the texels (46 bytes each at most) takes at
-    // most half the memory budget, else 1 (BakeStats::supersample says which).
+    // light-map state, about 2x the time. 4: 4 x 4 quarter-size ones (16x the
+    // texels, about 3x the time of 2). 1: texels as laid out. 0: as
+    // autoSupersample decides by the layout and the memory budget
+    // (BakeStats::supersample says which).
     int supersample = 1;
 };
 
@@ -130,7 +131,7 @@ struct BakeStats {
     // readLightmaps (LightmapPages::filledTexels)
     int64_t supersampleFilledTexels = 0;
     int64_t supersampleLostTexels = 0;  // left as padding (no neighbour on their chart either)
-    int supersample = 1;  // half-size texels a texel across (BakeOptions::supersample, auto resolved)
+    int supersample = 1;  // baked texels a texel across (BakeOptions::supersample, auto resolved)
     int64_t curvedTexelBytes = 0;   // their records (bake/curved_footprints.h), part of lightmapStateBytes
     std::vector<double> predictedOverActual;  // per tile: predicted nodes / actual nodes
     std::vector<int> tilesPerDirection;

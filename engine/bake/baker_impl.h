@@ -87,7 +87,7 @@ struct Baker::Impl {
     // noiseStride-th texel (8 bytes / stride^2 a page texel; its own memory category)
     gl::Texture halfAccum;
     gl::Texture noiseTerms;  // noise.comp's per-texel terms (RGBA32F, halfAccum's size)
-    gl::Texture noiseWeights;  // per sampled texel its half-size texels' weights (RGBA16F, noiseTerms' size)
+    gl::Texture noiseWeights;  // per half-size texel of halfAccum its weight in its texel (R16F, halfAccum's size)
     // halfAccum's side: ceil(output resolution / stride) x supersample. It keeps
     // every stride-th texel of the output layout's, all its half-size texels
     // (update.frag): the estimate is the reduced map's (noise.comp).

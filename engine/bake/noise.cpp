@@ -57,7 +57,7 @@ void Baker::Impl::estimateNoise() {
     glBindImageTexture(BINDING_HALF_ACCUM, halfAccum.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RG32UI);
     glBindImageTexture(BINDING_DIRECT, direct.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
     glBindImageTexture(BINDING_TARGET, noiseTerms.id(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glBindImageTexture(BINDING_NOISE_WEIGHTS, noiseWeights.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
+    glBindImageTexture(BINDING_NOISE_WEIGHTS, noiseWeights.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_R16F);
     glDispatchCompute(GLuint(width + 7) / 8, GLuint(width + 7) / 8, GLuint(layout.pageCount));
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
     std::vector<glm::vec4> values(size_t(width) * width * size_t(layout.pageCount));

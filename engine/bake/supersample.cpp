@@ -1,5 +1,7 @@
 #include "bake/supersample.h"
 
+#include "core/check.h"
+
 namespace bb {
 
 Layout supersampledLayout(const Layout& layout, int k) {
@@ -17,11 +19,41 @@ Layout supersampledLayout(const Layout& layout, int k) {
     return out;
 }
 
-TexelQuarters texelQuarters(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res) {
+int autoSupersample(const BakeMesh& mesh, const std::vector<uint32_t>& charts, const Layout& layout, int64_t memoryBudget) {
+    constexpr int64_t kMaxStateBytesPerTexel = 46;  // light-map state with double-sided materials
+    auto fits = [&](int k) {
+        return int64_t(layout.texelCount()) * k * k * kMaxStateBytesPerTexel <= memoryBudget / 2 &&
+               int64_t(layout.resolution) * k <= 16384;
+    };
+    if (!fits(2)) return 1;
+    if (!fits(4)) return 2;
+    int64_t covered = 0, cut = 0;
+    for (int p = 0; p < layout.pageCount; ++p) {
+        std::vector<uint8_t> partial;
+        const std::vector<int32_t> owners = halfTexelOwners(mesh, charts, p, layout.resolution, &partial);
+        for (size_t i = 0; i < owners.size(); ++i) {
+            covered += owners[i] >= 0;
+            cut += owners[i] >= 0 && partial[i];
+        }
+        cut += int64_t(sharedTexels(mesh, p, 2 * layout.resolution, owners, charts));
+    }
+    return cut * 5 >= covered ? 4 : 2;
+}
+
+std::vector<int32_t> fineTexelOwners(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res, int k,
+                                     std::vector<uint8_t>* partial) {
+    CHECK(k == 1 || k == 2 || k == 4);
+    if (k == 1) return texelOwners(mesh, page, res, partial);
+    if (k == 2) return halfTexelOwners(mesh, charts, page, res, partial);
+    const std::vector<int32_t> half = halfTexelOwners(mesh, charts, page, res);
+    return halfTexelOwners(mesh, charts, page, 2 * res, partial, &half);
+}
+
+TexelQuarters texelQuarters(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res,
+                            std::vector<int32_t> owner, const std::vector<int32_t>& fineOwner) {
     TexelQuarters out;
-    out.owner = texelOwners(mesh, page, res);
+    out.owner = std::move(owner);
     const std::vector<TexelFootprint> footprints = texelFootprints(mesh, page, res, out.owner, charts);
-    const std::vector<int32_t> fineOwner = halfTexelOwners(mesh, charts, page, res);
     const size_t perPage = size_t(res) * res;
     out.area.resize(perPage);
     out.weights.assign(perPage, glm::vec4(0.0f));
@@ -38,62 +70,115 @@ TexelQuarters texelQuarters(const BakeMesh& mesh, const std::vector<uint32_t>& c
     return out;
 }
 
+TexelQuarters texelQuarters(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res) {
+    return texelQuarters(mesh, charts, page, res, texelOwners(mesh, page, res), halfTexelOwners(mesh, charts, page, res));
+}
+
+std::vector<float> fineTexelWeights(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res, int k) {
+    const int fineRes = k * res;
+    std::vector<float> out(size_t(fineRes) * fineRes, 1.0f);
+    if (k == 1) return out;
+    const std::vector<int32_t> half = halfTexelOwners(mesh, charts, page, res);
+    const TexelQuarters top = texelQuarters(mesh, charts, page, res, texelOwners(mesh, page, res), half);
+    TexelQuarters below;  // k = 4: each half-size texel's quarters
+    if (k == 4) below = texelQuarters(mesh, charts, page, 2 * res, half, fineTexelOwners(mesh, charts, page, res, 4));
+    for (int y = 0; y < fineRes; ++y)
+        for (int x = 0; x < fineRes; ++x) {
+            const int hx = x * 2 / k, hy = y * 2 / k;  // the half-size texel it lies in
+            float w = top.weights[size_t(hy / 2) * size_t(res) + size_t(hx / 2)][(hx % 2) + 2 * (hy % 2)];
+            if (k == 4) {
+                const glm::vec4& q = below.weights[size_t(hy) * size_t(2 * res) + size_t(hx)];
+                const float sum = q.x + q.y + q.z + q.w;
+                w = sum > 0.0f ? w * q[(x % 2) + 2 * (y % 2)] / sum : 0.0f;
+            }
+            out[size_t(y) * size_t(fineRes) + size_t(x)] = w;
+        }
+    return out;
+}
+
+namespace {
+
+// One level of the reduction: page p of `fine` (2 res, its coverage) to res, each texel its
+// quarters' mean at `quarters`' weights; texels with none their chart's covered neighbours' mean,
+// else not covered (lost). Returns the values (w 1 where set).
+std::vector<glm::vec4> reduceLevel(const io::ImageRgb& from, const std::vector<uint8_t>& fromCovered,
+                                   const std::vector<uint32_t>& charts, int res, const TexelQuarters& quarters,
+                                   std::vector<uint8_t>& covered, LightmapPages& counts) {
+    const size_t perPage = size_t(res) * res;
+    const std::vector<int32_t>& owner = quarters.owner;
+    std::vector<glm::vec4> map(perPage, glm::vec4(0.0f));
+    covered.assign(perPage, 0);
+    for (size_t i = 0; i < perPage; ++i) {
+        const int x = int(i % size_t(res)), y = int(i / size_t(res));
+        if (owner[i] < 0) continue;
+        glm::dvec3 sum(0.0);
+        double weight = 0.0;
+        for (int q = 0; q < 4; ++q) {
+            const size_t j = size_t(2 * y + q / 2) * size_t(from.width) + size_t(2 * x + q % 2);
+            const double w = quarters.weights[i][q];
+            if (w == 0.0 || !fromCovered[j]) continue;
+            sum += glm::dvec3(from.pixels[j]) * w;
+            weight += w;
+        }
+        covered[i] = 1;
+        if (weight > 0.0) map[i] = glm::vec4(glm::vec3(sum / weight), 1.0f);
+    }
+    // texels with no half-size texel of their own: their chart's neighbours' mean, else padding
+    std::vector<std::pair<size_t, glm::vec4>> fill;
+    for (size_t i = 0; i < perPage; ++i) {
+        if (!covered[i] || map[i].w > 0.0f) continue;
+        const int x = int(i % size_t(res)), y = int(i / size_t(res));
+        glm::vec3 sum(0.0f);
+        float n = 0.0f;
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const int qx = x + dx, qy = y + dy;
+                if (qx < 0 || qy < 0 || qx >= res || qy >= res) continue;
+                const size_t j = size_t(qy) * size_t(res) + size_t(qx);
+                if (map[j].w > 0.0f && covered[j] && charts[size_t(owner[j])] == charts[size_t(owner[i])]) {
+                    sum += glm::vec3(map[j]);
+                    n += 1.0f;
+                }
+            }
+        if (n == 0.0f) continue;
+        fill.push_back({i, glm::vec4(sum / n, 1.0f)});
+        ++counts.filledTexels;
+    }
+    for (const auto& [i, value] : fill) map[i] = value;
+    for (size_t i = 0; i < perPage; ++i)
+        if (covered[i] && map[i].w == 0.0f) {
+            covered[i] = 0;
+            ++counts.lostTexels;
+        }
+    return map;
+}
+
+}  // namespace
+
 LightmapPages reduceLightmaps(const LightmapPages& fine, const BakeMesh& mesh, const std::vector<uint32_t>& charts,
                               const Layout& layout) {
-    const int res = layout.resolution, fineRes = fine.resolution;
-    const size_t perPage = size_t(res) * res;
+    const int res = layout.resolution, k = fine.resolution / res;
+    CHECK(k == 2 || k == 4);
     LightmapPages out;
     out.resolution = res;
-    std::vector<std::pair<size_t, glm::vec4>> fill;
     for (int p = 0; p < layout.pageCount; ++p) {
-        const TexelQuarters quarters = texelQuarters(mesh, charts, p, res);
-        const std::vector<int32_t>& owner = quarters.owner;
-        const io::ImageRgb& from = fine.pages[size_t(p)];
-        std::vector<glm::vec4> map(perPage, glm::vec4(0.0f));
-        std::vector<uint8_t> covered(perPage), area = quarters.area;
-        for (size_t i = 0; i < perPage; ++i) {
-            const int x = int(i % size_t(res)), y = int(i / size_t(res));
-            if (owner[i] < 0) continue;
-            glm::dvec3 sum(0.0);
-            double weight = 0.0;
-            for (int q = 0; q < 4; ++q) {
-                const size_t j = size_t(2 * y + q / 2) * size_t(fineRes) + size_t(2 * x + q % 2);
-                const double w = quarters.weights[i][q];
-                if (w == 0.0 || !fine.covered[size_t(p)][j]) continue;
-                sum += glm::dvec3(from.pixels[j]) * w;
-                weight += w;
-            }
-            covered[i] = 1;
-            if (weight > 0.0) map[i] = glm::vec4(glm::vec3(sum / weight), 1.0f);
+        io::ImageRgb from = fine.pages[size_t(p)];
+        std::vector<uint8_t> fromCovered = fine.covered[size_t(p)], covered;
+        const std::vector<int32_t> half = halfTexelOwners(mesh, charts, p, res);
+        if (k == 4) {  // quarter-size texels to half-size ones (their counts are not the output's)
+            LightmapPages counts;
+            const TexelQuarters q = texelQuarters(mesh, charts, p, 2 * res, half, fineTexelOwners(mesh, charts, p, res, 4));
+            const std::vector<glm::vec4> map = reduceLevel(from, fromCovered, charts, 2 * res, q, covered, counts);
+            from.width = from.height = 2 * res;
+            from.pixels.resize(map.size());
+            for (size_t i = 0; i < map.size(); ++i) from.pixels[i] = glm::vec3(map[i]);
+            fromCovered = covered;
         }
-        // texels with no half-size texel of their own: their chart's neighbours' mean, else padding
-        for (size_t i = 0; i < perPage; ++i) {
-            if (!covered[i] || map[i].w > 0.0f) continue;
-            const int x = int(i % size_t(res)), y = int(i / size_t(res));
-            glm::vec3 sum(0.0f);
-            float n = 0.0f;
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dx = -1; dx <= 1; ++dx) {
-                    const int qx = x + dx, qy = y + dy;
-                    if (qx < 0 || qy < 0 || qx >= res || qy >= res) continue;
-                    const size_t j = size_t(qy) * size_t(res) + size_t(qx);
-                    if (map[j].w > 0.0f && covered[j] && charts[size_t(owner[j])] == charts[size_t(owner[i])]) {
-                        sum += glm::vec3(map[j]);
-                        n += 1.0f;
-                    }
-                }
-            if (n == 0.0f) continue;
-            fill.push_back({i, glm::vec4(sum / n, 1.0f)});
-            ++out.filledTexels;
-        }
-        for (const auto& [i, value] : fill) map[i] = value;
-        for (size_t i = 0; i < perPage; ++i)
-            if (covered[i] && map[i].w == 0.0f) {
-                covered[i] = 0;
-                area[i] = 0;
-                ++out.lostTexels;
-            }
-        fill.clear();
+        const TexelQuarters quarters = texelQuarters(mesh, charts, p, res, texelOwners(mesh, p, res), half);
+        std::vector<glm::vec4> map = reduceLevel(from, fromCovered, charts, res, quarters, covered, out);
+        std::vector<uint8_t> area = quarters.area;
+        for (size_t i = 0; i < area.size(); ++i)
+            if (!covered[i]) area[i] = 0;
         out.pages.push_back(dilatedImage(std::move(map), res, layout.padding + 1));
         out.covered.push_back(std::move(covered));
         out.area.push_back(std::move(area));

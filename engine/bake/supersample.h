@@ -41,21 +41,45 @@ namespace bb {
 // and rectangles times k; the page UVs (rectangles' scale and offset) stay.
 Layout supersampledLayout(const Layout& layout, int k);
 
+// BakeOptions::supersample auto: the k whose light-map state (46 bytes a
+// texel at most) fits half the memory budget, 4 only where a fifth or more of
+// the half-size texels are partial (a chart's edge cuts them off their
+// centre) or shared with another chart; else 2 (and 1 where neither fits).
+// Why (docs/design-notes.md "Quarter-size texels"): at 2 x 2 the bias of
+// texels on strips and at chart edges is what is left on such layouts, and
+// 4 x 4 halves it for 2.7x the time, where on layouts of wide charts (the
+// Cornell box) the noise leads and more directions buy more.
+int autoSupersample(const BakeMesh& mesh, const std::vector<uint32_t>& charts, const Layout& layout, int64_t memoryBudget);
+
+// The owners of a bake's texels k x k to a layout texel at resolution `res`
+// (k res of them a side): texelOwners (k 1), halfTexelOwners (2), and at 4
+// halfTexelOwners again below the half-size texels', whose owners stand for
+// their texels': each level gives its texels' charts their parts first.
+std::vector<int32_t> fineTexelOwners(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res, int k,
+                                     std::vector<uint8_t>* partial = nullptr);
+
 // Page `page` of a layout at resolution `res`, as reduceLightmaps reads it:
 // per texel its owner (texelOwners), footprint area (texelFootprints, 255ths)
 // and its four half-size texels' weights in it (x + 2 y, y up the page): the
 // footprint's points in each quarter, 0 where no half-size texel of the
 // texel's own chart is (texelOwners at 2 res with a quarter of
-// kMinPartialTexelArea); all 0 for a texel not covered. The noise estimate
-// weighs the half-size texels by them too (Baker::Impl::estimateNoise).
+// kMinPartialTexelArea); all 0 for a texel not covered. The second form
+// takes the owners at res and 2 res (a level of a 4 x 4 bake's reduction).
 struct TexelQuarters {
     std::vector<int32_t> owner;
     std::vector<uint8_t> area;
     std::vector<glm::vec4> weights;
 };
 TexelQuarters texelQuarters(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res);
+TexelQuarters texelQuarters(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res,
+                            std::vector<int32_t> owner, const std::vector<int32_t>& fineOwner);
 
-// `fine`: the light maps of a bake on supersampledLayout(layout, 2), padding
+// Per texel of a bake k x k to a layout texel (k res a side), its weight in its
+// layout texel's value as reduceLightmaps composes it (1 at k 1): the noise
+// estimate weighs the texels by them (Baker::Impl::estimateNoise).
+std::vector<float> fineTexelWeights(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res, int k);
+
+// `fine`: the light maps of a bake on supersampledLayout(layout, k), k 2 or 4 (two levels), padding
 // dilated; `mesh`: the bake's mesh (either layout's: page UVs are the same);
 // `charts`: its findLightmapCharts.
 // Returns the light maps of `layout`, with `covered` and `area` by texelOwners

@@ -209,8 +209,8 @@ std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res, std::v
 }
 
 std::vector<int32_t> halfTexelOwners(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res,
-                                     std::vector<uint8_t>* partial) {
-    const std::vector<int32_t> coarse = texelOwners(mesh, page, res);
+                                     std::vector<uint8_t>* partial, const std::vector<int32_t>* coarseOwners) {
+    const std::vector<int32_t> coarse = coarseOwners ? *coarseOwners : texelOwners(mesh, page, res);
     std::vector<uint8_t> isPartial;
     std::vector<int32_t> owner = texelOwners(mesh, page, 2 * res, &isPartial, kMinPartialTexelArea / 4.0);
     const int fineRes = 2 * res;

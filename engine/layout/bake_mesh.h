@@ -117,8 +117,11 @@ std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res, std::v
 // half-size texel they lie in then take it from its texel's chart, the
 // smallest loss first, where that chart keeps at least half its part of the
 // texel in the other quarters (the texel's value leaves the rest out).
+// `coarse`: the texels' owners at res when not texelOwners' (a bake 4 x 4 to
+// a texel takes the half-size texels' as the texels of its quarter-size ones).
 std::vector<int32_t> halfTexelOwners(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res,
-                                     std::vector<uint8_t>* partial = nullptr);
+                                     std::vector<uint8_t>* partial = nullptr,
+                                     const std::vector<int32_t>* coarse = nullptr);
 
 // Which parts of each texel's square lie on its chart (the chart of its owner,
 // texelOwners): bit 8 j + i for the cell [i/8, (i+1)/8) x [j/8, (j+1)/8) of the

@@ -7,7 +7,7 @@
 // samples, zeros elsewhere; the CPU sums and scales by the halves' weights
 // (noise.cpp noiseHalvesFactor). A supersampled bake's texel is its half-size
 // texels' mean weighted by their parts of its footprint (bake/supersample.h
-// texelQuarters; `weights`, x + 2 y): M_e - M_o and L_lm are those texels'
+// fineTexelWeights; `weights`, halfAccum's size): M_e - M_o and L_lm are those texels'
 // means at those weights, over those where both halves hold samples.
 #include "shared/bundle_layout.h"
 #include "lib/rounding.glsl"
@@ -17,7 +17,7 @@ layout(binding = BINDING_ACCUM, rg32ui) uniform readonly uimage2DArray accum;
 layout(binding = BINDING_HALF_ACCUM, rg32ui) uniform readonly uimage2DArray halfAccum;
 layout(binding = BINDING_DIRECT, rgba16f) uniform readonly image2DArray directMap;
 layout(binding = BINDING_TARGET, rgba32f) uniform writeonly image2DArray target;
-layout(binding = BINDING_NOISE_WEIGHTS, rgba16f) uniform readonly image2DArray weights;
+layout(binding = BINDING_NOISE_WEIGHTS, r16f) uniform readonly image2DArray weights;
 uniform int halfStride;
 uniform int supersample;
 uniform int pageCount;
@@ -28,7 +28,6 @@ void main() {
     if (h.x >= pageSize.x || h.y >= pageSize.y || h.z >= pageCount) return;
     vec3 d = vec3(0.0), l = vec3(0.0);
     float n = 0.0;
-    vec4 w = imageLoad(weights, h);
     for (int j = 0; j < supersample; ++j)
         for (int i = 0; i < supersample; ++i) {
             ivec2 sub = ivec2(i, j);
@@ -37,7 +36,7 @@ void main() {
             vec4 odd = decodeAccumulator(imageLoad(halfAccum, ivec3(h.xy * supersample + sub, h.z)).rg);
             float evenWeight = whole.a - odd.a;
             // both halves need weight; the whole's W rounds (7 bits), so ask for a margin
-            float weight = w[i + 2 * j];
+            float weight = imageLoad(weights, ivec3(h.xy * supersample + sub, h.z)).r;
             if (weight <= 0.0 || odd.a <= 0.0 || evenWeight <= 0.02 * whole.a) continue;
             vec3 even = (whole.rgb * whole.a - odd.rgb * odd.a) / evenWeight;
             d += weight * (even - odd.rgb);

@@ -44,7 +44,7 @@ struct Node {
 #define BINDING_DILATION 6       // image unit: r8ui per texel: DILATION_SELF, the covered texel it copies, or DILATION_NONE
 #define BINDING_TARGET 7         // image unit: rgba32f light map L_lm (the resolve's output)
 #define BINDING_HALF_ACCUM 3     // image unit: rg32ui odd directions' accumulators at every halfStride-th texel
-#define BINDING_NOISE_WEIGHTS 5  // image unit, noise pass only: rgba16f a sampled texel's half-size texels' weights
+#define BINDING_NOISE_WEIGHTS 5  // image unit, noise pass only: r16f each sampled texel's half-size texels' weights
                                  // (the noise estimate; unit 3 is the direct-light scratch only while that is baked)
 #define BINDING_RADIANCE 0       // texture unit: RGB9_E5 outgoing radiance Lo per texel, array of pages
 #define BINDING_ENV 1            // texture unit: environment map (equirectangular)

@@ -254,9 +254,11 @@ int runInfo(const InfoArgs& args) {
 
 void addSupersampleOption(CLI::App& cmd, std::string& supersample) {
     cmd.add_option("--supersample", supersample,
-                   "Bake each light map texel as 2 x 2 half-size texels and average them over its footprint (2), or not (1): "
-                   "less bias and noise for 4x the light-map memory; auto = 2 when that takes at most half the memory budget")
-        ->check(CLI::IsMember({"auto", "1", "2"}))
+                   "Bake each light map texel as 2 x 2 half-size (or 4 x 4 quarter-size) texels and average them over its "
+                   "footprint, or not (1): less bias and noise for 4x (16x) the light-map memory; auto = 4 where a fifth of "
+                   "the half-size texels are cut by a chart's edge or shared by charts, else 2, each when it takes at most "
+                   "half the memory budget")
+        ->check(CLI::IsMember({"auto", "1", "2", "4"}))
         ->capture_default_str();
 }
 

@@ -81,5 +81,76 @@ TEST(Supersample, ATexelIsItsChartsHalfSizeTexelsWeightedByItsFootprint) {
     EXPECT_FLOAT_EQ(out.pages[0].pixels[0].x, out.pages[0].pixels[1 * 8 + 1].x);
 }
 
+
+// A bake 4 x 4 to a texel reduces in two levels (quarter-size texels to half-size
+// ones, those to the texel), each weighted by the footprint's points in its
+// quarters: the composition is the mean over the texel's footprint on its chart,
+// to the 32 x 32 grid's resolution, and the noise estimate's per-texel weights
+// (fineTexelWeights) give the same mean.
+TEST(Supersample, AQuarterSizeBakeReducesToTheMeanOverTheTexelsFootprint) {
+    const BakeMesh mesh = twoCharts();
+    const std::vector<uint32_t> charts = findLightmapCharts(mesh);
+    Layout layout;
+    layout.resolution = 8;
+    layout.pageCount = 1;
+    layout.padding = 1;
+    // the fine bake: every quarter-size texel reads its x (in quarter-size texels, centre), B's 100 more
+    const std::vector<int32_t> owners = fineTexelOwners(mesh, charts, 0, 8, 4);
+    ASSERT_EQ(owners.size(), size_t(32 * 32));
+    LightmapPages fine;
+    fine.resolution = 32;
+    io::ImageRgb img;
+    img.width = img.height = 32;
+    img.pixels.resize(owners.size());
+    std::vector<uint8_t> covered(owners.size());
+    for (size_t i = 0; i < owners.size(); ++i) {
+        if (owners[i] < 0) continue;
+        covered[i] = 1;
+        img.pixels[i] = glm::vec3(float(i % 32) + 0.5f + (charts[size_t(owners[i])] == charts[0] ? 0.0f : 100.0f));
+    }
+    fine.pages.push_back(img);
+    fine.covered.push_back(covered);
+    const LightmapPages out = reduceLightmaps(fine, mesh, charts, layout);
+    ASSERT_EQ(out.resolution, 8);
+    // A over x 4..4.6 of texel (4, 2): quarter-size columns 16 and 17 whole and 0.4 of 18, their mean
+    // (16.5 + 17.5 + 0.4 x 18.5) / 2.4 = 17.25 (the grid counts 0.375 of 18: 17.237)
+    const size_t t = 2 * 8 + 4;
+    EXPECT_NEAR(out.pages[0].pixels[t].x, 17.25f, 0.02f) << "A's part's mean; with B's slice it would be over 100";
+    EXPECT_FLOAT_EQ(out.pages[0].pixels[2 * 8 + 2].x, 10.0f) << "a whole texel: its sixteen's mean";
+    EXPECT_FLOAT_EQ(out.pages[0].pixels[2 * 8 + 5].x, 122.0f) << "B's texel (5, 2): B's alone";
+    EXPECT_EQ(out.filledTexels + out.lostTexels, 0);
+
+    const std::vector<float> weights = fineTexelWeights(mesh, charts, 0, 8, 4);
+    double sum = 0.0, weight = 0.0;
+    for (int y = 8; y < 12; ++y)
+        for (int x = 16; x < 20; ++x) {
+            const size_t i = size_t(y) * 32 + size_t(x);
+            if (weights[i] == 0.0f) continue;
+            EXPECT_EQ(charts[size_t(owners[i])], charts[0]) << "only A's quarter-size texels weigh in A's texel";
+            sum += weights[i] * img.pixels[i].x;
+            weight += weights[i];
+        }
+    EXPECT_NEAR(sum / weight, out.pages[0].pixels[t].x, 1e-3);
+}
+
+// auto: 4 where a fifth of the half-size texels are cut by a chart's edge or
+// shared, 2 on wide charts, each only where its state fits half the budget.
+TEST(Supersample, AutoBakesQuarterSizeTexelsWhereChartsAreNarrowerThanTexels) {
+    Layout layout;
+    layout.resolution = 16;
+    layout.pageCount = 1;
+    BakeMesh wide;  // one chart over 1..15, texel-aligned
+    addPageQuad(wide, {1.0f, 1.0f}, {15.0f, 15.0f}, 16.0f);
+    wide.pageFirstTriangle = {0, 2};
+    BakeMesh strips;  // strips 0.3 texel tall off the half-size texels' centres: each one cuts the two it lies in
+    for (int j = 0; j < 14; ++j) addPageQuad(strips, {1.0f, 1.275f + float(j)}, {15.0f, 1.575f + float(j)}, 16.0f);
+    strips.pageFirstTriangle = {0, uint32_t(strips.triangles.size())};
+    const int64_t budget = 1 << 20;  // 16 x 256 texels x 46 bytes = 188 KB: fits half
+    EXPECT_EQ(autoSupersample(wide, findLightmapCharts(wide), layout, budget), 2);
+    EXPECT_EQ(autoSupersample(strips, findLightmapCharts(strips), layout, budget), 4);
+    EXPECT_EQ(autoSupersample(strips, findLightmapCharts(strips), layout, 200 << 10), 2) << "16x the state does not fit";
+    EXPECT_EQ(autoSupersample(strips, findLightmapCharts(strips), layout, 40 << 10), 1) << "nor 4x";
+}
+
 }  // namespace
 }  // namespace bb
