@@ -61,7 +61,7 @@ struct ViewerArgs {
     std::string env;
     std::string rounding = "stochastic";
     float historyPower = -1.0f;
-    std::string supersample = "auto";  // auto | 1 | 2, as the bake command's
+    std::string supersample = "auto";  // auto | 1 | 2 | 4, as the bake command's
     // viewer
     int width = 1280, height = 720;
     double frameBudgetMs = 30.0;

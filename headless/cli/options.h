@@ -49,7 +49,7 @@ struct BakeArgs {
     float historyPower = -1.0f;
     std::string direct = "auto";
     int emitterSamples = 0;
-    std::string supersample = "auto";  // auto | 1 | 2 (BakeOptions::supersample)
+    std::string supersample = "auto";  // auto | 1 | 2 | 4 (BakeOptions::supersample)
     std::string seams = "stitch";     // stitch | off (bake/seam_stitch.h)
     bool preview = true;
     bool progress = true;
@@ -59,7 +59,7 @@ void addSceneOptions(CLI::App& cmd, SceneArgs& args);
 void addBakeOptions(CLI::App& cmd, BakeArgs& args);
 // --seams stitch|off (bake and reference): UV seams stitched before the light maps are written (bake/seam_stitch.h)
 void addSeamsOption(CLI::App& cmd, std::string& seams);
-// --supersample auto|1|2 (bake and viewer), and its BakeOptions::supersample (auto: 0)
+// --supersample auto|1|2|4 (bake and viewer), and its BakeOptions::supersample (auto: 0)
 void addSupersampleOption(CLI::App& cmd, std::string& supersample);
 int supersampleValue(const std::string& supersample);
 
