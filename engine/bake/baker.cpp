@@ -652,17 +652,16 @@ Status Baker::Impl::init(const Scene& scene) {
         halfAccum = gl::Texture::create2DArray("noise estimate: odd directions' accumulators", GL_RG32UI, halfWidth,
                                                halfWidth, pages);
         noiseTerms = gl::Texture::create2DArray("noise estimate terms", GL_RGBA32F, halfWidth / k, halfWidth / k, pages);
-        // the sampled texels' half-size texels' weights (the reduction's: fineTexelWeights)
+        // the sampled texels' half-size texels' weights (the reduction's: fineTexelWeights; whole texels 1)
         noiseWeights = gl::Texture::create2DArray("noise estimate: half-size texels' weights", GL_R16F, halfWidth, halfWidth, pages);
-        std::vector<float> weights(size_t(halfWidth) * halfWidth * size_t(pages), 0.0f);
-        for (int p = 0; p < pages; ++p) {
+        std::vector<float> weights(size_t(halfWidth) * halfWidth * size_t(pages), 1.0f);
+        for (int p = 0; p < pages && k > 1; ++p) {
             const std::vector<float> fine = fineTexelWeights(mesh, charts, p, outputRes, k);
             for (int y = 0; y < halfWidth; ++y)
                 for (int x = 0; x < halfWidth; ++x) {
                     const int fx = x / k * stats.noiseStride * k + x % k, fy = y / k * stats.noiseStride * k + y % k;
-                    if (fx < k * outputRes && fy < k * outputRes)
-                        weights[(size_t(p) * halfWidth + size_t(y)) * halfWidth + size_t(x)] =
-                            fine[size_t(fy) * size_t(k * outputRes) + size_t(fx)];
+                    weights[(size_t(p) * halfWidth + size_t(y)) * halfWidth + size_t(x)] =
+                        fx < k * outputRes && fy < k * outputRes ? fine[size_t(fy) * size_t(k * outputRes) + size_t(fx)] : 0.0f;
                 }
         }
         gl::writeTexture(noiseWeights.id(), 0, 0, 0, halfWidth, halfWidth, pages, GL_RED, GL_FLOAT, 4, weights.data());
