@@ -47,8 +47,8 @@ Layout supersampledLayout(const Layout& layout, int k);
 // centre) or shared with another chart; else 2 (and 1 where neither fits).
 // Why (docs/design-notes.md "Quarter-size texels"): at 2 x 2 the bias of
 // texels on strips and at chart edges is what is left on such layouts, and
-// 4 x 4 halves it for 2.7x the time, where on layouts of wide charts (the
-// Cornell box) the noise leads and more directions buy more.
+// 4 x 4 cuts it by a third for about 3x the time; on layouts of wide charts
+// (the Cornell box) the noise leads, and more directions buy more.
 int autoSupersample(const BakeMesh& mesh, const std::vector<uint32_t>& charts, const Layout& layout, int64_t memoryBudget);
 
 // The owners of a bake's texels k x k to a layout texel at resolution `res`
