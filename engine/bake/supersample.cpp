@@ -70,10 +70,6 @@ TexelQuarters texelQuarters(const BakeMesh& mesh, const std::vector<uint32_t>& c
     return out;
 }
 
-TexelQuarters texelQuarters(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res) {
-    return texelQuarters(mesh, charts, page, res, texelOwners(mesh, page, res), halfTexelOwners(mesh, charts, page, res));
-}
-
 std::vector<float> fineTexelWeights(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res, int k) {
     const int fineRes = k * res;
     std::vector<float> out(size_t(fineRes) * fineRes, 1.0f);

@@ -58,19 +58,18 @@ int autoSupersample(const BakeMesh& mesh, const std::vector<uint32_t>& charts, c
 std::vector<int32_t> fineTexelOwners(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res, int k,
                                      std::vector<uint8_t>* partial = nullptr);
 
-// Page `page` of a layout at resolution `res`, as reduceLightmaps reads it:
-// per texel its owner (texelOwners), footprint area (texelFootprints, 255ths)
-// and its four half-size texels' weights in it (x + 2 y, y up the page): the
-// footprint's points in each quarter, 0 where no half-size texel of the
-// texel's own chart is (texelOwners at 2 res with a quarter of
-// kMinPartialTexelArea); all 0 for a texel not covered. The second form
-// takes the owners at res and 2 res (a level of a 4 x 4 bake's reduction).
+// Page `page` of a layout at resolution `res`, as reduceLightmaps reads it,
+// from the texels' owners at res and 2 res (texelOwners and halfTexelOwners,
+// or a level of a 4 x 4 bake's: the half-size and quarter-size texels'): per
+// texel its owner, footprint area (texelFootprints, 255ths) and its four
+// half-size texels' weights in it (x + 2 y, y up the page): the footprint's
+// points in each quarter, 0 where the half-size texel is not of the texel's
+// chart; all 0 for a texel not covered.
 struct TexelQuarters {
     std::vector<int32_t> owner;
     std::vector<uint8_t> area;
     std::vector<glm::vec4> weights;
 };
-TexelQuarters texelQuarters(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res);
 TexelQuarters texelQuarters(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res,
                             std::vector<int32_t> owner, const std::vector<int32_t>& fineOwner);
 
