@@ -40,13 +40,20 @@ int autoSupersample(const BakeMesh& mesh, const std::vector<uint32_t>& charts, c
     return cut * 5 >= covered ? 4 : 2;
 }
 
+namespace {
+// A 4 x 4 bake's owners, from the half-size texels' (halfTexelOwners at res)
+std::vector<int32_t> quarterTexelOwners(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res,
+                                        const std::vector<int32_t>& half, std::vector<uint8_t>* partial = nullptr) {
+    return halfTexelOwners(mesh, charts, page, 2 * res, partial, &half);
+}
+}  // namespace
+
 std::vector<int32_t> fineTexelOwners(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res, int k,
                                      std::vector<uint8_t>* partial) {
     CHECK(k == 1 || k == 2 || k == 4);
     if (k == 1) return texelOwners(mesh, page, res, partial);
     if (k == 2) return halfTexelOwners(mesh, charts, page, res, partial);
-    const std::vector<int32_t> half = halfTexelOwners(mesh, charts, page, res);
-    return halfTexelOwners(mesh, charts, page, 2 * res, partial, &half);
+    return quarterTexelOwners(mesh, charts, page, res, halfTexelOwners(mesh, charts, page, res), partial);
 }
 
 TexelQuarters texelQuarters(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res,
@@ -71,13 +78,13 @@ TexelQuarters texelQuarters(const BakeMesh& mesh, const std::vector<uint32_t>& c
 }
 
 std::vector<float> fineTexelWeights(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res, int k) {
+    CHECK(k == 2 || k == 4);
     const int fineRes = k * res;
-    std::vector<float> out(size_t(fineRes) * fineRes, 1.0f);
-    if (k == 1) return out;
+    std::vector<float> out(size_t(fineRes) * fineRes);
     const std::vector<int32_t> half = halfTexelOwners(mesh, charts, page, res);
     const TexelQuarters top = texelQuarters(mesh, charts, page, res, texelOwners(mesh, page, res), half);
     TexelQuarters below;  // k = 4: each half-size texel's quarters
-    if (k == 4) below = texelQuarters(mesh, charts, page, 2 * res, half, fineTexelOwners(mesh, charts, page, res, 4));
+    if (k == 4) below = texelQuarters(mesh, charts, page, 2 * res, half, quarterTexelOwners(mesh, charts, page, res, half));
     for (int y = 0; y < fineRes; ++y)
         for (int x = 0; x < fineRes; ++x) {
             const int hx = x * 2 / k, hy = y * 2 / k;  // the half-size texel it lies in
@@ -163,7 +170,7 @@ LightmapPages reduceLightmaps(const LightmapPages& fine, const BakeMesh& mesh, c
         const std::vector<int32_t> half = halfTexelOwners(mesh, charts, p, res);
         if (k == 4) {  // quarter-size texels to half-size ones (their counts are not the output's)
             LightmapPages counts;
-            const TexelQuarters q = texelQuarters(mesh, charts, p, 2 * res, half, fineTexelOwners(mesh, charts, p, res, 4));
+            const TexelQuarters q = texelQuarters(mesh, charts, p, 2 * res, half, quarterTexelOwners(mesh, charts, p, res, half));
             const std::vector<glm::vec4> map = reduceLevel(from, fromCovered, charts, 2 * res, q, covered, counts);
             from.width = from.height = 2 * res;
             from.pixels.resize(map.size());

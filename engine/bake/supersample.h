@@ -73,8 +73,8 @@ struct TexelQuarters {
 TexelQuarters texelQuarters(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res,
                             std::vector<int32_t> owner, const std::vector<int32_t>& fineOwner);
 
-// Per texel of a bake k x k to a layout texel (k res a side), its weight in its
-// layout texel's value as reduceLightmaps composes it (1 at k 1): the noise
+// Per texel of a bake k x k to a layout texel (k res a side; k 2 or 4), its
+// weight in its layout texel's value as reduceLightmaps composes it: the noise
 // estimate weighs the texels by them (Baker::Impl::estimateNoise).
 std::vector<float> fineTexelWeights(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res, int k);
 
