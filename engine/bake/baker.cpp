@@ -874,10 +874,6 @@ LightmapPages Baker::readLightmaps() {
         std::vector<uint8_t> cov(size_t(res) * res);
         gl::readTexture(m.dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, cov.data());
         for (uint8_t& c : cov) c = c == DILATION_SELF;
-        std::vector<glm::uvec3> footprints(cov.size());
-        gl::readTexture(m.footprint.id(), 0, 0, p, res, res, 1, GL_RGB_INTEGER, GL_UNSIGNED_INT, 12, footprints.data());
-        std::vector<uint8_t> area(cov.size());
-        for (size_t i = 0; i < area.size(); ++i) area[i] = uint8_t(footprints[i].z >> 24);
         for (int y0 = 0; y0 < res; y0 += rows) {
             const int n = std::min(rows, res - y0);
             m.resolveInto(band, y0, n, p, 1);
@@ -886,7 +882,6 @@ LightmapPages Baker::readLightmaps() {
         }
         out.pages.push_back(std::move(img));
         out.covered.push_back(std::move(cov));
-        out.area.push_back(std::move(area));
     }
     m.noteMemory();
     if (m.options.supersample == 1) return out;

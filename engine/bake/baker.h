@@ -189,10 +189,6 @@ struct LightmapPages {
     int resolution = 0;
     std::vector<io::ImageRgb> pages;
     std::vector<std::vector<uint8_t>> covered;
-    // per page and texel, the part of its square on its chart in 255ths
-    // (layout/bake_mesh.h texelFootprints: what the bake's samples cover);
-    // empty: whole squares (the reference's maps, maps read from files)
-    std::vector<std::vector<uint8_t>> area;
     // covered texels a supersampled bake's reduction filled from their neighbours (bake/supersample.h)
     int64_t filledTexels = 0;
     int64_t lostTexels = 0;  // and those left as padding: no neighbour on their chart either

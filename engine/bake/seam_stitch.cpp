@@ -185,15 +185,17 @@ SeamStitchStats stitchSeams(LightmapPages& maps, const Seams& seams, const SeamS
                                       rows[r][size_t(i)].weight * rows[r][size_t(j)].weight);
     // covered texels hold what the bake measured (their footprints' means): they
     // move coveredKeepFactor times less than the padding texels the seams'
-    // lookups tap, less so as their part on the chart shrinks (maps.area): a
-    // bundle pixel's centre crosses a texel a tenth on its chart in a tenth
+    // lookups tap, less so as their part on the chart shrinks (Seams::texelArea):
+    // a bundle pixel's centre crosses a texel a tenth on its chart in a tenth
     // of the directions (update.frag footprintPixel), and its value is that
     // much noisier
     Eigen::VectorXd keep(n);
     for (Eigen::Index i = 0; i < n; ++i) {
         const uint64_t key = texels[size_t(i)];
         const size_t page = size_t(key >> 40), texel = size_t(key & ((uint64_t(1) << 40) - 1));
-        const double area = maps.area.empty() ? 1.0 : std::max(double(maps.area[page][texel]), 1.0) / 255.0;
+        const double area = page < seams.texelArea.size() && !seams.texelArea[page].empty()
+                                ? std::max(double(seams.texelArea[page][texel]), 1.0) / 255.0
+                                : 1.0;
         keep(i) = options.keepWeight * (maps.covered[page][texel] ? options.coveredKeepFactor * area : 1.0);
         triplets.emplace_back(i, i, keep(i));
     }

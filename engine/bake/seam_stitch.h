@@ -44,7 +44,8 @@ struct SeamStitchOptions {
     // city_sky, 1024 directions) against the converged reference: 3.9 %
     // unstitched; stitched 5.3 % with 1, 4.6 % with 3 (seam RMS 0.154 -> 0.021,
     // 0.016 with 1), 4.1 % with 10 (0.029; the golden sphere's seams then stay
-    // above its noise).
+    // above its noise). Times the part of the texel's square on its chart
+    // (Seams::texelArea, from the mesh: the same for a bake and the reference).
     double coveredKeepFactor = 3.0;
 };
 

@@ -62,12 +62,10 @@ TexelQuarters texelQuarters(const BakeMesh& mesh, const std::vector<uint32_t>& c
     out.owner = std::move(owner);
     const std::vector<TexelFootprint> footprints = texelFootprints(mesh, page, res, out.owner, charts);
     const size_t perPage = size_t(res) * res;
-    out.area.resize(perPage);
     out.weights.assign(perPage, glm::vec4(0.0f));
     for (size_t i = 0; i < perPage; ++i) {
         if (out.owner[i] < 0) continue;
         const int x = int(i % size_t(res)), y = int(i / size_t(res));
-        out.area[i] = footprints[i].area;
         for (int q = 0; q < 4; ++q) {
             const int32_t o = fineOwner[size_t(2 * y + q / 2) * size_t(2 * res) + size_t(2 * x + q % 2)];
             if (o >= 0 && charts[size_t(o)] == charts[size_t(out.owner[i])])
@@ -179,12 +177,8 @@ LightmapPages reduceLightmaps(const LightmapPages& fine, const BakeMesh& mesh, c
         }
         const TexelQuarters quarters = texelQuarters(mesh, charts, p, res, texelOwners(mesh, p, res), half);
         std::vector<glm::vec4> map = reduceLevel(from, fromCovered, charts, res, quarters, covered, out);
-        std::vector<uint8_t> area = quarters.area;
-        for (size_t i = 0; i < area.size(); ++i)
-            if (!covered[i]) area[i] = 0;
         out.pages.push_back(dilatedImage(std::move(map), res, layout.padding + 1));
         out.covered.push_back(std::move(covered));
-        out.area.push_back(std::move(area));
     }
     return out;
 }

@@ -61,13 +61,11 @@ std::vector<int32_t> fineTexelOwners(const BakeMesh& mesh, const std::vector<uin
 // Page `page` of a layout at resolution `res`, as reduceLightmaps reads it,
 // from the texels' owners at res and 2 res (texelOwners and halfTexelOwners,
 // or a level of a 4 x 4 bake's: the half-size and quarter-size texels'): per
-// texel its owner, footprint area (texelFootprints, 255ths) and its four
-// half-size texels' weights in it (x + 2 y, y up the page): the footprint's
-// points in each quarter, 0 where the half-size texel is not of the texel's
-// chart; all 0 for a texel not covered.
+// texel its owner and its four half-size texels' weights in it (x + 2 y, y up
+// the page): the footprint's points in each quarter, 0 where the half-size
+// texel is not of the texel's chart; all 0 for a texel not covered.
 struct TexelQuarters {
     std::vector<int32_t> owner;
-    std::vector<uint8_t> area;
     std::vector<glm::vec4> weights;
 };
 TexelQuarters texelQuarters(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res,
@@ -81,8 +79,8 @@ std::vector<float> fineTexelWeights(const BakeMesh& mesh, const std::vector<uint
 // `fine`: the light maps of a bake on supersampledLayout(layout, k), k 2 or 4 (two levels), padding
 // dilated; `mesh`: the bake's mesh (either layout's: page UVs are the same);
 // `charts`: its findLightmapCharts.
-// Returns the light maps of `layout`, with `covered` and `area` by texelOwners
-// and texelFootprints at its resolution.
+// Returns the light maps of `layout`, with `covered` by texelOwners at its
+// resolution.
 LightmapPages reduceLightmaps(const LightmapPages& fine, const BakeMesh& mesh, const std::vector<uint32_t>& charts,
                               const Layout& layout);
 

@@ -55,6 +55,15 @@ TEST(Seams, SplitDiagonalIsOneSeamSampledAlongBothSides) {
         EXPECT_GT(p.texelA.x, 0.0f);
         EXPECT_LT(p.texelA.x, 4.0f);
     }
+    // the part of each texel's square on its chart, which the stitch weighs
+    // texels by: the same for a bake's maps and the reference's
+    ASSERT_EQ(s.texelArea.size(), 1u);
+    ASSERT_EQ(s.texelArea[0].size(), 256u);
+    const auto area = [&](int x, int y) { return double(s.texelArea[0][size_t(y) * 16 + size_t(x)]) / 255.0; };
+    EXPECT_NEAR(area(3, 0), 1.0, 0.01) << "inside A";
+    EXPECT_NEAR(area(8, 3), 1.0, 0.01) << "inside B";
+    EXPECT_NEAR(area(1, 1), 0.5, 0.1) << "halved by the diagonal, the rest off every chart (counted on a grid)";
+    EXPECT_EQ(area(6, 6), 0.0) << "off the charts";
 }
 
 // Two charts a quarter texel apart: each side's lookups tap texels the other
