@@ -69,8 +69,9 @@ struct Seams {
     std::vector<SeamSamplePair> samples;  // seam by seam, in triangle order
     // Per page that a sample's lookup is on, per texel the part of its square
     // on its chart in 255ths (texelFootprints' area; 0 off the charts); empty
-    // for the other pages (whole squares, as for seams made by hand). The stitch weighs texels by it (seam_stitch.h), so
-    // a bake and the reference, whose maps carry no such record, stitch alike.
+    // for the other pages (whole squares, as for seams made by hand). The
+    // stitch weighs texels by it (seam_stitch.h), so a bake and the
+    // reference, whose maps carry no such record, stitch alike.
     std::vector<std::vector<uint8_t>> texelArea;
 };
 
