@@ -163,15 +163,15 @@ Seams findSeams(const BakeMesh& mesh, int resolution, const SeamOptions& options
             out.samples.push_back({uint32_t(seam), pageA, pageB, ta, tb});
         }
     }
+    // the part of each texel on its chart, on the pages whose owners the seams needed
     out.texelArea.resize(owners.size());
-    for (const SeamSamplePair& s : out.samples)
-        for (const uint32_t page : {s.pageA, s.pageB}) {
-            if (!out.texelArea[page].empty()) continue;
-            const std::vector<TexelFootprint> footprints = texelFootprints(mesh, int(page), resolution, owners[page], chartOf);
-            out.texelArea[page].resize(footprints.size());
-            for (size_t i = 0; i < footprints.size(); ++i)
-                out.texelArea[page][i] = owners[page][i] >= 0 ? footprints[i].area : uint8_t(0);
-        }
+    for (size_t page = 0; page < owners.size(); ++page) {
+        if (owners[page].empty()) continue;
+        const std::vector<TexelFootprint> footprints = texelFootprints(mesh, int(page), resolution, owners[page], chartOf);
+        out.texelArea[page].resize(footprints.size());
+        for (size_t i = 0; i < footprints.size(); ++i)
+            out.texelArea[page][i] = owners[page][i] >= 0 ? footprints[i].area : uint8_t(0);
+    }
     return out;
 }
 

@@ -67,7 +67,7 @@ struct Seams {
     // texel of its own for the two sides to agree on (docs/design-notes.md).
     size_t narrowPairs = 0;
     std::vector<SeamSamplePair> samples;  // seam by seam, in triangle order
-    // Per page that a sample's lookup is on, per texel the part of its square
+    // Per page that a seam is on, per texel the part of its square
     // on its chart in 255ths (texelFootprints' area; 0 off the charts); empty
     // for the other pages (whole squares, as for seams made by hand). The
     // stitch weighs texels by it (seam_stitch.h), so a bake and the
