@@ -44,6 +44,7 @@ import json
 import math
 import os
 import platform
+import re
 import shutil
 import struct
 import subprocess
@@ -447,7 +448,7 @@ def interp_loglog(points, t):
     return None
 
 
-def write_outputs(name, cfg, rows, ref_note, ref_seconds):
+def write_outputs(name, cfg, rows, ref_note, ref_seconds, measured=None):
     outdir = os.path.join(RESULTS, name)
     os.makedirs(outdir, exist_ok=True)
     fields = ["scene", "method", "param", "value", "seconds", "process_seconds", "rel_rmse", "rmse", "rel_mse",
@@ -492,7 +493,7 @@ def write_outputs(name, cfg, rows, ref_note, ref_seconds):
 
     lines = ["### %s" % name, "",
              "Measured %s. Scene `%s`, flags `%s`; converged reference: %s%s." %
-             (datetime.datetime.now().strftime("%Y-%m-%d %H:%M"), cfg["path"], " ".join(cfg["flags"]), ref_note,
+             (measured or datetime.datetime.now().strftime("%Y-%m-%d %H:%M"), cfg["path"], " ".join(cfg["flags"]), ref_note,
               (", %.1f s" % ref_seconds) if ref_seconds else ""),
              "bundlebake: defaults (bundle resolution from the texel density, 512M budget, stochastic rounding, "
              "automatic history power, supersample auto), seed %s. Reference sweep: 2 threads, seed %s, flags `%s`." %
@@ -501,32 +502,65 @@ def write_outputs(name, cfg, rows, ref_note, ref_seconds):
         lines.append("Estimated noise of the converged reference itself: rel_rmse %.4f (a floor under every error "
                      "below)." % noise)
         lines.append("")
-    lines += ["| baker | setting | time s | process s | rel_rmse | own noise estimate | mean_ratio | max_abs | "
-              "reference's rel_rmse at equal time | ratio |",
-              "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    lines += ["| baker | setting | time s | process s | rel_rmse | less the reference's noise | own noise estimate | "
+              "estimate / error | mean_ratio | max_abs | reference's rel_rmse at equal time | ratio |",
+              "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in gpu:
         at = interp_loglog(cpu_curve, r["seconds"])
+        # the bake's error against the truth: the converged reference's own noise is independent of it
+        own = math.sqrt(max(r["rel_rmse"] ** 2 - (noise or 0.0) ** 2, 0.0))
         estimate = "%.4f" % r["noise_estimate"] if r["noise_estimate"] != "" else "-"
-        lines.append("| bundlebake | %d directions | %.3f | %.2f | %.4f | %s | %.4f | %.4g | %s | %s |" %
-                     (r["value"], r["seconds"], r["process_seconds"], r["rel_rmse"], estimate, r["mean_ratio"],
-                      r["max_abs"], "%.4f" % at if at else "out of range", "%.2f" % (r["rel_rmse"] / at) if at else "-"))
+        versus = "%.2f" % (r["noise_estimate"] / own) if r["noise_estimate"] != "" and own > 0 else "-"
+        lines.append("| bundlebake | %d directions | %.3f | %.2f | %.4f | %.4f | %s | %s | %.4f | %.4g | %s | %s |" %
+                     (r["value"], r["seconds"], r["process_seconds"], r["rel_rmse"], own, estimate, versus,
+                      r["mean_ratio"], r["max_abs"], "%.4f" % at if at else "out of range",
+                      "%.2f" % (r["rel_rmse"] / at) if at else "-"))
     for r in cpu:
-        lines.append("| reference | %d spp | %.3f | %.2f | %.4f | | %.4f | %.4g | | |" %
+        lines.append("| reference | %d spp | %.3f | %.2f | %.4f | | | | %.4f | %.4g | | |" %
                      (r["value"], r["seconds"], r["process_seconds"], r["rel_rmse"], r["mean_ratio"], r["max_abs"]))
     lines.append("")
     lines.append("ratio = bundlebake's error / the reference baker's error at the same time (log-log interpolated); "
                  "the goal is <= 0.5. Own noise estimate: bundlebake's stats.json noise.relative, from the even and "
-                 "odd directions without a reference; it holds noise only, so it falls short of rel_rmse by the bias.")
+                 "odd directions without a reference; it holds noise only, so it falls short of rel_rmse by the bias. Less "
+                 "the reference's noise: sqrt(rel_rmse^2 - its noise^2), the bake's error against the truth (the two "
+                 "are independent); estimate / error is the estimate over it (the goal: within 1.5x either way).")
     lines.append("")
     with open(os.path.join(outdir, "table.md"), "w") as f:
         f.write("\n".join(lines))
     return "\n".join(lines)
 
 
+def rewrite_tables(name, cfg):
+    """The table and plot of a scene again from its results.csv and the header of its table.md (--tables-only)."""
+    outdir = os.path.join(RESULTS, name)
+    with open(os.path.join(outdir, "results.csv"), newline="") as f:
+        rows = list(csv.DictReader(f))
+    for r in rows:
+        for k in ("value", "texels"):
+            r[k] = int(r[k])
+        for k in ("seconds", "process_seconds", "rel_rmse", "rmse", "rel_mse", "mean_ratio", "max_abs"):
+            r[k] = float(r[k])
+        r["noise_estimate"] = float(r["noise_estimate"]) if r["noise_estimate"] else ""
+    with open(os.path.join(outdir, "table.md")) as f:
+        head = f.read()
+    when = re.search(r"Measured ([\d-]+ [\d:]+)\.", head)
+    m = re.search(r"converged reference: (.*?)(?:, ([\d.]+) s)?\.\n", head)
+    return write_outputs(name, cfg, rows, m[1], float(m[2]) if m[2] else 0.0,
+                         measured=when[1] if when else committed(os.path.join(outdir, "results.csv")))
+
+
+def committed(path):
+    """When `path` was last committed (older tables did not say when they were measured)."""
+    out = subprocess.run(["git", "-C", ROOT, "log", "-1", "--format=%ci", "--", path], capture_output=True, text=True)
+    return out.stdout.strip()[:16] + " (committed)" if out.stdout.strip() else "at an unknown date"
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--bundlebake", default=None, help="the CLI (default: build-ref/, build/ under the repository)")
     ap.add_argument("--scenes", default=",".join(SCENES), help="comma-separated: " + ", ".join(SCENES))
+    ap.add_argument("--tables-only", action="store_true",
+                    help="rewrite the tables, plots and summary from the kept results.csv, running nothing")
     ap.add_argument("--quick", action="store_true", help="first three points of each sweep, 1/8 of the converged spp")
     args = ap.parse_args()
     exe = args.bundlebake
@@ -535,7 +569,7 @@ def main():
             if os.path.exists(os.path.join(ROOT, d, "bundlebake")):
                 exe = os.path.join(ROOT, d, "bundlebake")
                 break
-    if not exe or not os.path.exists(exe):
+    if not args.tables_only and (not exe or not os.path.exists(exe)):
         sys.exit("speed_vs_error: no bundlebake binary (build it, or pass --bundlebake)")
     t0 = time.monotonic()
     sections = {}
@@ -547,6 +581,9 @@ def main():
             cfg["spp"] = cfg["spp"][:3]
             if "converged_spp" in cfg:
                 cfg["converged_spp"] //= 8
+        if args.tables_only:
+            sections[name] = rewrite_tables(name, cfg)
+            continue
         if "make" in cfg:
             cfg["make"]()
         ref, note, ref_seconds = converged_reference(exe, name, cfg)
@@ -565,7 +602,8 @@ def main():
               "GL: Mesa llvmpipe (CPU). Whole run: %.0f s." %
               (datetime.datetime.now().strftime("%Y-%m-%d %H:%M"), platform.node(), os.cpu_count(),
                platform.processor() or platform.machine(), load[0], load[1], load[2], time.monotonic() - t0),
-              "This run: %s; the other scenes' tables are from their last runs." % ", ".join(run), ""]
+              ("Tables rewritten from the kept results (--tables-only): %s." if args.tables_only else
+               "This run: %s; the other scenes' tables are from their last runs.") % ", ".join(run), ""]
     os.makedirs(RESULTS, exist_ok=True)
     with open(os.path.join(RESULTS, "summary.md"), "w") as f:
         f.write("\n".join(header + [sections[n] for n in SCENES if n in sections]))
