@@ -430,7 +430,9 @@ void Viewer::drawPanel() {
                         "");
         // the bake's own estimate (engine/bake/noise.cpp), from the latest radiance refresh
         if (baker_->stats().noiseRelative >= 0)
-            ImGui::Text("noise %.2f %% (relative RMS, estimated)", 100.0 * baker_->stats().noiseRelative);
+            ImGui::Text("error %.2f %% (relative RMS, estimated: noise %.2f %%, bounces to come %.2f %%)",
+                        100.0 * baker_->stats().noiseRelative, 100.0 * baker_->stats().noiseHalves,
+                        100.0 * baker_->stats().noiseLag);
         ImGui::Text("%.1f ms per tile, %.1f s baking", tileSeconds_ * 1e3, bakeSeconds_);
         if (ImGui::Button(paused_ ? "Resume" : "Pause")) paused_ = !paused_;
         ImGui::SameLine();

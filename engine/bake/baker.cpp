@@ -142,8 +142,9 @@ nlohmann::json BakeStats::toJson() const {
     j["seconds"] = {{"setup", secondsSetup}, {"importance", secondsImportance}, {"tiling", secondsTiling}, {"sun", secondsSun}, {"emitters", secondsEmitters}, {"bundle", secondsBundle}, {"update", secondsUpdate},
                     {"resolve", secondsResolve}, {"combine", secondsCombine}, {"total", secondsTotal()}};
     if (combines > 0) j["combine"] = {{"count", combines}, {"bytes_sent", combineBytes}};
-    j["noise"] = {{"relative", noiseRelative}, {"sampled_texels", noiseTexels}, {"stride", noiseStride},
-                  {"stopped_at_target", stoppedAtTargetNoise}, {"history", noiseHistory}};
+    j["noise"] = {{"relative", noiseRelative}, {"halves", noiseHalves}, {"lag", noiseLag},
+                  {"sampled_texels", noiseTexels}, {"stride", noiseStride}, {"stopped_at_target", stoppedAtTargetNoise},
+                  {"history", noiseHistory}};
     return j;
 }
 
@@ -568,6 +569,7 @@ Status Baker::Impl::init(const Scene& scene) {
         texelArea += 0.5 * std::abs(double(e1.x) * e2.y - double(e1.y) * e2.x);
     }
     double density = worldArea > 0 && texelArea > 0 ? std::sqrt(texelArea / worldArea) : 1.0 / sphereRadius;
+    texelSize = 1.0 / density;
     if (options.bundleResolution > 0) {
         gridSize = options.bundleResolution;
         pixelSize = 2.0f * sphereRadius / float(gridSize);

@@ -153,12 +153,14 @@ struct BakeStats {
     int64_t combines = 0;
     int64_t combineBytes = 0;
     double secondsCombine = 0;        // all of it, including the share's waiting and transfer
-    // The noise estimate (noise.cpp): RMS of the light map's standard deviation
-    // over its mean, from the odd and even directions' halves at sampled texels
-    double noiseRelative = -1;        // < 0: not yet estimated
+    // The noise estimate (noise.cpp): the light maps' relative error without a
+    // reference, sqrt(noiseHalves^2 + noiseLag^2); < 0: not yet estimated
+    double noiseRelative = -1;
+    double noiseHalves = 0;           // RMS of the maps' standard deviation over their mean (odd and even halves)
+    double noiseLag = 0;              // RMS of the bounces still to come over the maps' mean (bounceLag)
     int noiseStride = 1;              // every noiseStride-th texel of each axis is sampled
     int64_t noiseTexels = 0;          // sampled texels the last estimate used
-    std::vector<std::pair<int, double>> noiseHistory;  // (directions done, relative noise) at refreshes
+    std::vector<std::pair<int, double>> noiseHistory;  // (directions done, noiseRelative) at refreshes
     bool stoppedAtTargetNoise = false;
     double secondsTotal() const {
         return secondsSetup + secondsSun + secondsEmitters + secondsTiling + secondsBundle + secondsUpdate +

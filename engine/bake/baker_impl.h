@@ -38,6 +38,7 @@ struct Baker::Impl {
     glm::vec3 sphereCenter{0.0f};
     float sphereRadius = 1.0f;
     float pixelSize = 1.0f;
+    double texelSize = 1.0;  // the mean texel's side, scene units (sqrt(world area / texel area))
     double sunPixelSize = 0;  // adaptive: the scene's finest pixel, for the sun's jittered bundles (0: pixelSize)
     int gridSize = 1;         // pixels across the uniform bundle (--tiling uniform, captures)
     int maxTileSize = 2048;   // largest head image side the budget allows
@@ -199,6 +200,7 @@ struct Baker::Impl {
     // history; stops the bake (directionsGoal) when --target-noise is reached
     void estimateNoise();
     double noiseHalvesFactor() const;  // noise.cpp
+    double bounceLag() const;          // noise.cpp
     int directionsGoal() const { return stats.stoppedAtTargetNoise ? stats.directionsDone : options.directions; }
 };
 

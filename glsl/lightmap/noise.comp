@@ -3,7 +3,8 @@
 // mean splits into the odd directions' half (halfAccum, kept by the update
 // pass at every halfStride-th texel) and the even directions' (the whole
 // minus the odd: M_e = (M W - M_o W_o) / (W - W_o)). Writes (sum over RGB of
-// (M_e - M_o)^2, sum over RGB of L_lm, 1) for texels where both halves hold
+// (M_e - M_o)^2, sum over RGB of L_lm, 1, sum over RGB of M^2: the bounced
+// light, which noise.cpp's bounceLag scales) for texels where both halves hold
 // samples, zeros elsewhere; the CPU sums and scales by the halves' weights
 // (noise.cpp noiseHalvesFactor). A supersampled bake's texel is its half-size
 // texels' mean weighted by their parts of its footprint (bake/supersample.h
@@ -26,7 +27,7 @@ uniform ivec2 pageSize;  // sampled texels of the output layout a side (halfAccu
 void main() {
     ivec3 h = ivec3(gl_GlobalInvocationID.xy, gl_GlobalInvocationID.z);
     if (h.x >= pageSize.x || h.y >= pageSize.y || h.z >= pageCount) return;
-    vec3 d = vec3(0.0), l = vec3(0.0);
+    vec3 d = vec3(0.0), l = vec3(0.0), b = vec3(0.0);
     float n = 0.0;
     for (int j = 0; j < supersample; ++j)
         for (int i = 0; i < supersample; ++i) {
@@ -41,6 +42,7 @@ void main() {
             vec3 even = (whole.rgb * whole.a - odd.rgb * odd.a) / evenWeight;
             d += weight * (even - odd.rgb);
             l += weight * (whole.rgb + imageLoad(directMap, t).rgb);
+            b += weight * whole.rgb;
             n += weight;
         }
     if (n == 0.0) {
@@ -49,5 +51,6 @@ void main() {
     }
     d /= n;
     l /= n;
-    imageStore(target, h, vec4(dot(d, d), l.r + l.g + l.b, 1.0, 0.0));
+    b /= n;
+    imageStore(target, h, vec4(dot(d, d), l.r + l.g + l.b, 1.0, dot(b, b)));
 }

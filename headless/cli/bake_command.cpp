@@ -79,8 +79,9 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
         ->capture_default_str();
     addSupersampleOption(cmd, a.supersample);
     cmd.add_option("--target-noise", a.targetNoise,
-                   "Stop once the estimated relative noise of the light maps is at most this (e.g. 0.01; checked at "
-                   "radiance refreshes from 16 directions on; --directions is then the most); 0 = off")
+                   "Stop once the light maps' estimated relative error (their noise and the bounces still to come) is "
+                   "at most this (e.g. 0.01; checked at radiance refreshes from 16 directions on; --directions is then "
+                   "the most); 0 = off")
         ->check(CLI::Range(0.0, 1.0))
         ->capture_default_str();
     addSeamsOption(cmd, a.seams);
