@@ -200,7 +200,11 @@ struct Baker::Impl {
     // history; stops the bake (directionsGoal) when --target-noise is reached
     void estimateNoise();
     double noiseHalvesFactor() const;  // noise.cpp
-    double bounceLag() const;          // noise.cpp
+    double bounceLag();                // noise.cpp
+    struct LagModel {                  // bounceLag's state: rounds run, mean, weight, mean read
+        int rounds = 0;
+        double mean = 0, weight = 0, read = 0;
+    } lagModel;
     int directionsGoal() const { return stats.stoppedAtTargetNoise ? stats.directionsDone : options.directions; }
 };
 

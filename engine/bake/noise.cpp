@@ -69,22 +69,24 @@ double Baker::Impl::noiseHalvesFactor() const {
 // 0.246, 0.389, 0.609 (without f: 0.256, 0.424, 0.642; at --bundle-res
 // 2048, r ~ 11, the bake reads 0.262 at 4); power 0: 0.293 at 16 (baked
 // 0.293).
-double Baker::Impl::bounceLag() const {
+// The model advances from the rounds it has run (a resumed bake runs it from 0).
+double Baker::Impl::bounceLag() {
     const double lambda = stats.transportAlbedo;
     const int done = stats.directionsDone / shareCount();
     if (!(lambda > 0.0) || done < 1) return 0.0;
     const double r = tilerOptions.fixedPixelSize > 0.0 ? texelSize / tilerOptions.fixedPixelSize
                                                          : tilerOptions.pixelsPerTexel;
     const double missed = r * r >= 1.0 ? 0.5 / (r * r) : 1.0 - 0.5 * r * r;
-    double mean = 0.0, weight = 0.0, read = 0.0;  // weight relative to round j's
-    for (int j = 0; j < done; ++j) {
-        if (j > 0) weight *= std::exp(rampLogWeight(j - 1) - rampLogWeight(j));
-        const double hit = (mean * weight + 1.0 + lambda * read) / (weight + 1.0);
-        mean = j == 0 ? hit : (1.0 - missed) * hit + missed * mean;
-        weight += j == 0 ? 1.0 : 1.0 - missed;
-        if ((j + 1) % refreshInterval(j) == 0 || j + 1 == rounds()) read = mean;
+    LagModel& m = lagModel;  // its weight is relative to its last round's
+    for (int j = m.rounds; j < done; ++j) {
+        if (j > 0) m.weight *= std::exp(rampLogWeight(j - 1) - rampLogWeight(j));
+        const double hit = (m.mean * m.weight + 1.0 + lambda * m.read) / (m.weight + 1.0);
+        m.mean = j == 0 ? hit : (1.0 - missed) * hit + missed * m.mean;
+        m.weight += j == 0 ? 1.0 : 1.0 - missed;
+        if ((j + 1) % refreshInterval(j) == 0 || j + 1 == rounds()) m.read = m.mean;
     }
-    return std::max(0.0, 1.0 - mean * (1.0 - lambda));
+    m.rounds = std::max(m.rounds, done);
+    return std::max(0.0, 1.0 - m.mean * (1.0 - lambda));
 }
 
 void Baker::Impl::estimateNoise() {
