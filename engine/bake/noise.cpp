@@ -58,13 +58,16 @@ double Baker::Impl::noiseHalvesFactor() const {
 // refresh before it, lambda the scene's transport albedo (its dominant
 // eigenvalue, the slowest mode); the fixed point is 1 / (1 - lambda) and the
 // lag 1 - M (1 - lambda). A share f of the texels gets no sample in a round
-// (its square, seen along the direction, covers no pixel centre) and keeps
-// its mean, which under a steep ramp is the round before's, a bounce behind:
-// with r pixels a texel side, a square at cos c to the direction covers
-// r^2 c pixels, and with a random phase holds no centre with probability
-// 1 - r^2 c where that is positive, f = integral over c in [0, 1] of it
-// (c is uniform: the directions are uniform over the sphere): 1 / (2 r^2),
-// 1/8 at the default 2 pixels a texel. Against the rho 0.9 furnace (L_lm
+// and keeps its mean, which under a steep ramp is the round before's, a
+// bounce behind: a sample is skipped where its pixel's ray crosses its
+// surface farther than D = max(2 pixels, a texel) from its point
+// (update.frag ownCrossing). With pixel p, the ray passes the point at d,
+// uniform in [0, p/2] across the direction's tilt, and at cos c crosses
+// d / c away: skipped with probability 1 - 2 c D / p where positive; over c
+// uniform in [0, 1] (the directions are uniform over the sphere), f = p / (4 D)
+// = 1 / (4 max(r, 2)) at r pixels a texel side, 1/8 at the default 2 (the
+// three neighbouring pixels the walk also tries lie farther across the
+// tilt). Against the rho 0.9 furnace (L_lm
 // 10), power 57: 0.242, 0.396, 0.603 of 10 at 4, 8, 16 directions, baked
 // 0.246, 0.389, 0.609 (without f: 0.256, 0.424, 0.642; at --bundle-res
 // 2048, r ~ 11, the bake reads 0.262 at 4); power 0: 0.293 at 16 (baked
@@ -76,7 +79,7 @@ double Baker::Impl::bounceLag() {
     if (!(lambda > 0.0) || done < 1) return 0.0;
     const double r = tilerOptions.fixedPixelSize > 0.0 ? texelSize / tilerOptions.fixedPixelSize
                                                          : tilerOptions.pixelsPerTexel;
-    const double missed = r * r >= 1.0 ? 0.5 / (r * r) : 1.0 - 0.5 * r * r;
+    const double missed = 0.25 / std::max(r, 2.0);
     LagModel& m = lagModel;  // its weight is relative to its last round's
     for (int j = m.rounds; j < done; ++j) {
         if (j > 0) m.weight *= std::exp(rampLogWeight(j - 1) - rampLogWeight(j));
