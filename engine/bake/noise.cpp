@@ -57,17 +57,14 @@ double Baker::Impl::noiseHalvesFactor() const {
 // the rounds done: a round's sample x = 1 + lambda M_r, M_r the mean at the
 // refresh before it, lambda the scene's transport albedo (its dominant
 // eigenvalue, the slowest mode); the fixed point is 1 / (1 - lambda) and the
-// lag 1 - M (1 - lambda). A share f of the texels gets no sample in a round
-// and keeps its mean, which under a steep ramp is the round before's, a
-// bounce behind: a sample is skipped where its pixel's ray crosses its
-// surface farther than D = max(2 pixels, a texel) from its point
-// (update.frag ownCrossing). With pixel p, the ray passes the point at d,
-// uniform in [0, p/2] across the direction's tilt, and at cos c crosses
-// d / c away: skipped with probability 1 - 2 c D / p where positive; over c
-// uniform in [0, 1] (the directions are uniform over the sphere), f = p / (4 D)
-// = 1 / (4 max(r, 2)) at r pixels a texel side, 1/8 at the default 2 (the
-// three neighbouring pixels the walk also tries lie farther across the
-// tilt). Against the rho 0.9 furnace (L_lm
+// lag 1 - M (1 - lambda). Under a steep ramp the bake falls behind that
+// (rho 0.9 furnace, power 57, 8 directions: 0.389 of its light against 0.424),
+// as if a share f of the texels kept its mean each round, a bounce behind:
+// f = 1/8 matches it at the default 2 pixels a texel side (below), and at 11
+// (--bundle-res 2048) the bake keeps up (f ~ 0). Why is not known: the
+// suspect, the walk skipping samples whose ray crosses the surface more than
+// a texel away (update.frag ownCrossing), moved nothing when widened.
+// f = 1 / (4 max(r, 2)) at r pixels a texel side spans the two. Against the rho 0.9 furnace (L_lm
 // 10), power 57: 0.242, 0.396, 0.603 of 10 at 4, 8, 16 directions, baked
 // 0.246, 0.389, 0.609 (without f: 0.256, 0.424, 0.642; at --bundle-res
 // 2048, r ~ 11, the bake reads 0.262 at 4); power 0: 0.293 at 16 (baked
