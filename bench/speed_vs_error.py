@@ -521,7 +521,8 @@ def write_outputs(name, cfg, rows, ref_note, ref_seconds, measured=None):
     lines.append("")
     lines.append("ratio = bundlebake's error / the reference baker's error at the same time (log-log interpolated); "
                  "the goal is <= 0.5. Own noise estimate: bundlebake's stats.json noise.relative, from the even and "
-                 "odd directions without a reference; it holds noise only, so it falls short of rel_rmse by the bias. Less "
+                 "odd directions without a reference, and the bounces still to come (noise.lag; tables measured before "
+                 "2026-12-05 09:40 hold the noise only); it falls short of rel_rmse by the other biases. Less "
                  "the reference's noise: sqrt(rel_rmse^2 - its noise^2), the bake's error against the truth (the two "
                  "are independent); estimate / error is the estimate over it (the goal: within 1.5x either way).")
     lines.append("")
@@ -551,8 +552,8 @@ def rewrite_tables(name, cfg):
 
 def committed(path):
     """When `path` was last committed (older tables did not say when they were measured)."""
-    out = subprocess.run(["git", "-C", ROOT, "log", "-1", "--format=%ci", "--", path], capture_output=True, text=True)
-    return out.stdout.strip()[:16] + " (committed)" if out.stdout.strip() else "at an unknown date"
+    out, _ = run(["git", "-C", ROOT, "log", "-1", "--format=%ci", "--", path])
+    return out.strip()[:16] + " (committed)" if out.strip() else "at an unknown date"
 
 
 def main():

@@ -186,6 +186,8 @@ struct Baker::Impl {
     int refreshInterval(int round) const {
         return std::clamp((round - std::max(0, refreshEveryRound - 64)) / 32, 1, 8);
     }
+    // Whether the outgoing radiance is refreshed after round j (finishRound, and bounceLag's model of it).
+    bool refreshesAfter(int round) const { return (round + 1) % refreshInterval(round) == 0 || round + 1 == rounds(); }
     void noteMemory();  // peaks into stats
     // The outgoing radiance the bundles read: meta.frag over every page, then the padding.
     void refreshRadiance(uint32_t key);  // key: the direction just done (random numbers)

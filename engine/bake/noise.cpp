@@ -64,11 +64,11 @@ double Baker::Impl::noiseHalvesFactor() const {
 // (--bundle-res 2048) the bake keeps up (f ~ 0). Why is not known: the
 // suspect, the walk skipping samples whose ray crosses the surface more than
 // a texel away (update.frag ownCrossing), moved nothing when widened.
-// f = 1 / (4 max(r, 2)) at r pixels a texel side spans the two. Against the rho 0.9 furnace (L_lm
-// 10), power 57: 0.242, 0.396, 0.603 of 10 at 4, 8, 16 directions, baked
-// 0.246, 0.389, 0.609 (without f: 0.256, 0.424, 0.642; at --bundle-res
-// 2048, r ~ 11, the bake reads 0.262 at 4); power 0: 0.293 at 16 (baked
-// 0.293).
+// f = 1 / (4 max(r, 2)) at r pixels a texel side spans the two. Against
+// the rho 0.9 furnace (L_lm 10), power 57: 0.242, 0.396, 0.603 of 10 at 4, 8,
+// 16 directions, baked 0.246, 0.389, 0.609 (without f: 0.256, 0.424, 0.642;
+// at --bundle-res 2048, r ~ 11, the bake reads 0.262 at 4); power 0: 0.293
+// at 16 (baked 0.293).
 // The model advances from the rounds it has run (a resumed bake runs it from 0).
 double Baker::Impl::bounceLag() {
     const double lambda = stats.transportAlbedo;
@@ -83,7 +83,7 @@ double Baker::Impl::bounceLag() {
         const double hit = (m.mean * m.weight + 1.0 + lambda * m.read) / (m.weight + 1.0);
         m.mean = j == 0 ? hit : (1.0 - missed) * hit + missed * m.mean;
         m.weight += j == 0 ? 1.0 : 1.0 - missed;
-        if ((j + 1) % refreshInterval(j) == 0 || j + 1 == rounds()) m.read = m.mean;
+        if (refreshesAfter(j)) m.read = m.mean;
     }
     m.rounds = std::max(m.rounds, done);
     return std::max(0.0, 1.0 - m.mean * (1.0 - lambda));

@@ -84,7 +84,7 @@ void Baker::Impl::finishRound(int round) {
     // Refresh the outgoing radiance the next bundles read. After every round
     // while each one adds a bounce the estimate needs; later every j/32 rounds
     // (at most 8): the estimate then moves slowly and the refresh is a pass over every page.
-    if ((round + 1) % refreshInterval(round) == 0 || round + 1 == rounds()) {
+    if (refreshesAfter(round)) {
         auto tr = Clock::now();
         combineShares(round);
         stats.secondsCombine += secondsSince(tr);
