@@ -105,7 +105,7 @@ nlohmann::json BakeStats::toJson() const {
     j["tiles"] = {{"drawn", tilesDrawn}, {"per_direction_mean", meanTiles}, {"per_direction_max", maxTiles},
                   {"leaves_per_direction_mean", meanLeaves},
                   {"curvature_refined_triangles", curvatureRefinedTriangles},
-                  {"overflows_redrawn", overflows},
+                  {"overflows_redrawn", overflows}, {"updates_over_all_leaves", allLeavesUpdates},
                   {"predicted_over_actual_nodes", {{"min", pct(0)}, {"p10", pct(0.1)}, {"median", pct(0.5)},
                                                    {"p90", pct(0.9)}, {"max", pct(1)}, {"count", predictedOverActual.size()}}},
                   {"pixel_size_scene_units", {{"min", size(0)}, {"median", size(0.5)}, {"max", size(1)}}}};
@@ -161,10 +161,17 @@ Status Baker::Impl::buildPrograms() {
         std::string defines;
     } specs[] = {
         {&updateProgram, {"lightmap/update.vert", "lightmap/update.frag"}, rounding + backSidesDefine()},
+        {&updateAllLeavesProgram, {"lightmap/update.vert", "lightmap/update.frag"},
+         rounding + backSidesDefine() + "#define LEAF_TABLE 1\n"},
+        {&updateCurvedAllLeavesProgram, {"lightmap/curved.vert", "lightmap/update.frag"},
+         rounding + backSidesDefine() + "#define CURVED_FOOTPRINT 1\n#define LEAF_TABLE 1\n"},
         {&sunProgram, {"lightmap/update.vert", "lightmap/update.frag"}, "#define SUN_PASS 1\n"},
         {&updateCurvedProgram, {"lightmap/curved.vert", "lightmap/update.frag"},
          rounding + backSidesDefine() + "#define CURVED_FOOTPRINT 1\n"},
         {&sunCurvedProgram, {"lightmap/curved.vert", "lightmap/update.frag"}, "#define SUN_PASS 1\n#define CURVED_FOOTPRINT 1\n"},
+        {&sunAllLeavesProgram, {"lightmap/update.vert", "lightmap/update.frag"}, "#define SUN_PASS 1\n#define LEAF_TABLE 1\n"},
+        {&sunCurvedAllLeavesProgram, {"lightmap/curved.vert", "lightmap/update.frag"},
+         "#define SUN_PASS 1\n#define CURVED_FOOTPRINT 1\n#define LEAF_TABLE 1\n"},
         {&resolveProgram, {"lightmap/resolve.comp"}, ""},
         {&rescaleProgram, {"lightmap/rescale.comp"}, rounding},
         {&noiseProgram, {"lightmap/noise.comp"}, ""},

@@ -108,6 +108,7 @@ struct BakeStats {
     double transportAlbedo = 0;       // the light's share kept per bounce (bake/transport_albedo.h)
     double radianceUnit = 1;          // the light-map state holds radiance / this (a power of two; fp16 range)
     int64_t tilesDrawn = 0;
+    int64_t allLeavesUpdates = 0;     // directions updated in one pass over all their leaves (bundle_tracer.h)
     int64_t overflows = 0;            // tile draws whose node count exceeded the buffer: redrawn (bigger buffer, or split)
     int64_t fragments = 0;            // nodes appended (kept) for the tiles' own pixels, over all tiles
     int64_t updatedTexels = 0;        // texel samples accumulated

@@ -101,6 +101,8 @@ struct Baker::Impl {
     }
     gl::Texture envTexture;
     gl::Framebuffer pageFbo;
+    // the update's programs over one tile, and over all of a direction's leaves at once (bundle_tracer.h)
+    gl::Program updateAllLeavesProgram, updateCurvedAllLeavesProgram, sunAllLeavesProgram, sunCurvedAllLeavesProgram;
     gl::Program updateProgram, sunProgram, updateCurvedProgram, sunCurvedProgram, resolveProgram, rescaleProgram, metaProgram, coverageProgram,
         dilateProgram, readModesProgram, directFoldProgram, distanceProgram, emitterProgram, emitterCurvedProgram,
         emitterFoldProgram, punctualProgram, punctualCurvedProgram,

@@ -23,10 +23,12 @@ void setFrameUniforms(GLuint program, const TileFrame& f) {
     glUniform1f(glGetUniformLocation(program, "leafExtent"), float(f.leaf.extent));
     glUniform1i(glGetUniformLocation(program, "leafPixels"), f.leaf.pixels);
     glUniform1f(glGetUniformLocation(program, "pixelSize"), f.pixelSize);
-    glUniform2i(glGetUniformLocation(program, "tileOffset"), f.drawn.x, f.drawn.y);
-    glUniform2i(glGetUniformLocation(program, "tileSize"), f.drawn.width, f.drawn.height);
-    glUniform4i(glGetUniformLocation(program, "ownedPixels"), f.window.x - f.drawn.x, f.window.y - f.drawn.y,
-                f.window.x - f.drawn.x + f.window.width, f.window.y - f.drawn.y + f.window.height);
+    // head image pixel p is the leaf's pixel p + tileOffset
+    const glm::ivec2 o = f.headOrigin;
+    glUniform2i(glGetUniformLocation(program, "tileOffset"), f.drawn.x - o.x, f.drawn.y - o.y);
+    glUniform4i(glGetUniformLocation(program, "drawnPixels"), o.x, o.y, o.x + f.drawn.width, o.y + f.drawn.height);
+    glUniform4i(glGetUniformLocation(program, "ownedPixels"), f.window.x - f.drawn.x + o.x, f.window.y - f.drawn.y + o.y,
+                f.window.x - f.drawn.x + o.x + f.window.width, f.window.y - f.drawn.y + o.y + f.window.height);
 }
 
 Expected<std::unique_ptr<BundleTracer>> BundleTracer::create(const BundleScene& scene, const BundleLimits& limits,
@@ -115,7 +117,41 @@ void drawCurvedTexelRuns(GLuint program, int res, const std::vector<int32_t>& fi
         }
 }
 
-void BundleTracer::begin(const BundleFrame& frame, const TilerOptions& options, uint32_t seed, bool recordStats) {
+bool BundleTracer::planAllLeaves() {
+    const std::vector<Tile>& tiles = tiling_.tiles;
+    if (tiles.size() < 2) return false;
+    std::vector<int> sides(tiling_.leaves.size(), 0);
+    double predicted = 0;
+    for (const Tile& t : tiles) {
+        const int pixels = tiling_.leaves[size_t(t.leaf)].pixels;
+        if (t.window.x != 0 || t.window.y != 0 || t.window.width != pixels || t.window.height != pixels) return false;
+        sides[size_t(t.leaf)] = pixels;
+        predicted += t.predictedNodes;
+    }
+    const int64_t nodes = int64_t(std::ceil(1.25 * predicted)) + 1024;
+    if (nodes > limits_.nodeCapacity) return false;
+    int side = 0;
+    headOrigins_ = packSquares(sides, limits_.maxTileSize, side);  // leaves without a tile take no room
+    if (headOrigins_.empty()) return false;
+    if (limits_.predict) ensureNodes(nodes);
+    ensureHeads(side);
+    leafRecords_.clear();
+    for (const Tile& t : tiles) {
+        const BundleLeaf& l = tiling_.leaves[size_t(t.leaf)];
+        const glm::ivec2 o = headOrigins_[size_t(t.leaf)];
+        leafRecords_.push_back({float(l.min.x), float(l.min.y), float(l.extent), l.pixels,
+                                float(tiling_.pixelSize(t.leaf)), o.x, o.y, 0});
+    }
+    const int64_t bytes = int64_t(leafRecords_.size() * sizeof(shared::LeafRecord));
+    if (leafTable_.bytes() < bytes)
+        leafTable_ = gl::Buffer::create("bundle leaf table", std::max<int64_t>(bytes, 64 * int64_t(sizeof(shared::LeafRecord))),
+                                        nullptr, GL_DYNAMIC_STORAGE_BIT);
+    glNamedBufferSubData(leafTable_.id(), 0, bytes, leafRecords_.data());
+    return true;
+}
+
+void BundleTracer::begin(const BundleFrame& frame, const TilerOptions& options, uint32_t seed, bool recordStats,
+                         bool allLeaves) {
     auto t0 = Clock::now();
     frame_ = frame;
     options_ = options;
@@ -125,6 +161,10 @@ void BundleTracer::begin(const BundleFrame& frame, const TilerOptions& options, 
     tiling_ = tileBundle(*scene_.clusters, views_, frame.size, options);
     work_.assign(tiling_.tiles.rbegin(), tiling_.tiles.rend());
     tiles_ = 0;
+    drawnTiles_.clear();
+    drawnClusters_.clear();
+    drawnNodes_ = drawnOwned_ = 0;
+    allLeaves_ = allLeaves && planAllLeaves();
     if (recordStats) {
         stats_->secondsTiling += secondsSince(t0);
         stats_->leavesPerDirection.push_back(int(tiling_.leaves.size()));
@@ -133,8 +173,8 @@ void BundleTracer::begin(const BundleFrame& frame, const TilerOptions& options, 
 }
 
 void BundleTracer::run(const BundleFrame& frame, const TilerOptions& options, uint32_t seed, bool recordStats,
-                       const UpdateFn& update) {
-    begin(frame, options, seed, recordStats);
+                       const UpdateFn& update, bool allLeaves) {
+    begin(frame, options, seed, recordStats, allLeaves);
     while (!done()) next(update);
 }
 
@@ -152,11 +192,13 @@ void BundleTracer::next(const UpdateFn& update) {
     f.window = tile.window;
     f.drawn = drawnWindow(tile.window, f.leaf.pixels);
     f.pixelSize = float(tiling_.pixelSize(tile.leaf));
-    // per direction and leaf, never per tile: tiles change with the budget, the bits must not
-    const uint32_t leafSeed = pcgHash(seed_ ^ pcgHash(uint32_t(tile.leaf) * 7919u + 17u));
-    // buffers sized from the prediction (a quarter of margin), within the budget
-    if (limits_.predict) ensureNodes(int64_t(std::ceil(1.25 * tile.predictedNodes)) + 1024);
-    ensureHeads(std::max(f.drawn.width, f.drawn.height));
+    if (allLeaves_) {
+        f.headOrigin = headOrigins_[size_t(tile.leaf)];
+    } else {
+        // buffers sized from the prediction (a quarter of margin), within the budget
+        if (limits_.predict) ensureNodes(int64_t(std::ceil(1.25 * tile.predictedNodes)) + 1024);
+        ensureHeads(std::max(f.drawn.width, f.drawn.height));
+    }
 
     // what both passes read (the mesh's SSBOs: per chunk, in drawClusters)
     glBindVertexArray(scene_.vertexArray);
@@ -167,37 +209,8 @@ void BundleTracer::next(const UpdateFn& update) {
     }
 
     auto tb = Clock::now();
-    {
-        gl::DebugGroup group("bundle pass");
-        const uint32_t endOfList = END_OF_LIST, zero[2] = {0, 0};
-        glClearTexSubImage(heads_.id(), 0, 0, 0, 0, f.drawn.width, f.drawn.height, 1, GL_RED_INTEGER,
-                           GL_UNSIGNED_INT, &endOfList);
-        glNamedBufferSubData(counter_.id(), 0, 8, zero);
-        glUseProgram(append_.id());
-        setFrameUniforms(append_.id(), f);
-        glUniform1ui(append_.uniform("nodeCapacity"), uint32_t(nodeAllocated_));
-        glUniform1ui(append_.uniform("randomSeed"), leafSeed);
-        glUniform1i(append_.uniform("backLayerOffset"), scene_.backLayerOffset);
-        // the leaf's grid in a power-of-two viewport (glsl/bundle/append.vert) shifted so the
-        // drawn window (the tile and its apron) lands at (0, 0); the scissor keeps the rest out
-        int viewportPixels = 1;
-        while (viewportPixels < f.leaf.pixels) viewportPixels *= 2;
-        glUniform1i(append_.uniform("viewportPixels"), viewportPixels);
-        glUniform1f(append_.uniform("subpixelSteps"), float(1 << limits_.subpixelBits));
-        glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
-        glViewport(-f.drawn.x, -f.drawn.y, viewportPixels, viewportPixels);
-        glEnable(GL_SCISSOR_TEST);
-        glScissor(0, 0, f.drawn.width, f.drawn.height);
-        glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, BINDING_NODE_COUNTER, counter_.id());
-        glBindImageTexture(BINDING_HEADS, heads_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
-        glBindTextureUnit(BINDING_RADIANCE, scene_.radiance);
-        glBindTextureUnit(BINDING_READ_MODES, scene_.readModes);
-        glBindTextureUnit(BINDING_TEXEL_CHARTS, scene_.texelCharts);
-        drawClusters(append_.id(), tile.clusters, false);
-        glDisable(GL_SCISSOR_TEST);
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
-                        GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-    }
+    // with one update over all leaves the tiles append to the same buffer: the counts are the direction's so far
+    drawBundle(tile, f, !allLeaves_ || drawnTiles_.empty());
     uint32_t counts[2] = {0, 0};
     glGetNamedBufferSubData(counter_.id(), 0, 8, counts);
     const uint32_t count = counts[0];
@@ -208,9 +221,16 @@ void BundleTracer::next(const UpdateFn& update) {
         ++stats_->tilesDrawn;
     }
     if (int64_t(count) > nodeAllocated_) {
-        // overflow: nothing is used from this draw. Redraw into a buffer of
-        // the measured size if the budget holds it, else in four quarters.
+        // overflow: nothing is used from this draw.
         if (recordStats_) ++stats_->overflows;
+        if (allLeaves_) {  // nothing updated yet: the direction again, tile by tile
+            allLeaves_ = false;
+            work_.assign(tiling_.tiles.rbegin(), tiling_.tiles.rend());
+            drawnTiles_.clear();
+            drawnClusters_.clear();
+            return;
+        }
+        // Redraw into a buffer of the measured size if the budget holds it, else in four quarters.
         if (int64_t(count) <= limits_.nodeCapacity && limits_.predict) {
             ensureNodes(int64_t(count));
             work_.push_back(std::move(tile));
@@ -222,39 +242,93 @@ void BundleTracer::next(const UpdateFn& update) {
         }
         return;
     }
+    const uint32_t before = allLeaves_ ? drawnNodes_ : 0u, ownedBefore = allLeaves_ ? drawnOwned_ : 0u;
+    drawnTiles_.push_back({tile.predictedNodes, count - before, counts[1] - ownedBefore, f.pixelSize});
+    if (allLeaves_) {
+        drawnNodes_ = count;
+        drawnOwned_ = counts[1];
+        drawnClusters_.insert(drawnClusters_.end(), tile.clusters.begin(), tile.clusters.end());
+        if (!work_.empty()) return;  // the update follows the last tile
+        std::sort(drawnClusters_.begin(), drawnClusters_.end());
+        drawnClusters_.erase(std::unique(drawnClusters_.begin(), drawnClusters_.end()), drawnClusters_.end());
+        f.allLeaves = true;
+    }
     if (recordStats_) {
-        stats_->fragments += counts[1];  // each once, whichever tile owns it
-        stats_->peakNodesPerTile = std::max<int64_t>(stats_->peakNodesPerTile, count);
-        if (count > 0) stats_->predictedOverActual.push_back(tile.predictedNodes / count);
-        stats_->tilePixelSizes.push_back(f.pixelSize);
-    }
-    if (count > 0) {
-        auto tu = Clock::now();
-        gl::DebugGroup group("update pass");
-        glBindFramebuffer(GL_FRAMEBUFFER, scene_.pageFramebuffer);
-        glViewport(0, 0, scene_.pageResolution, scene_.pageResolution);
-        const UpdatePrograms programs = update(f, count);
-        glBindImageTexture(BINDING_HEADS, heads_.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
-        // the two draws update disjoint texels (update.frag leaves curved ones to the second)
-        for (GLuint program : {programs.triangles, programs.curved}) {
-            if (!program) continue;
-            glUseProgram(program);
-            setFrameUniforms(program, f);
-            glUniform1ui(glGetUniformLocation(program, "nodeCount"), count);
-            if (program == programs.triangles)
-                drawClusters(program, tile.clusters, true);
-            else
-                drawCurvedTexels(program, tile.clusters);
+        for (const DrawnTile& t : drawnTiles_) {
+            stats_->fragments += t.owned;  // each once, whichever tile owns it
+            if (t.nodes > 0) stats_->predictedOverActual.push_back(t.predicted / t.nodes);
+            stats_->tilePixelSizes.push_back(t.pixelSize);
         }
-        if (programs.triangles || programs.curved)
-            glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
-        if (recordStats_) {
-            glFinish();
-            stats_->secondsUpdate += secondsSince(tu);
-        }
+        stats_->peakNodesPerTile = std::max<int64_t>(stats_->peakNodesPerTile, count);  // what the buffer held
+        stats_->allLeavesUpdates += f.allLeaves;
     }
+    drawnTiles_.clear();
+    if (count > 0) runUpdate(update, f, count, f.allLeaves ? drawnClusters_ : tile.clusters);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     if (recordStats_ && work_.empty()) stats_->tilesPerDirection.push_back(tiles_);
+}
+
+void BundleTracer::drawBundle(const Tile& tile, const TileFrame& f, bool resetCounter) {
+    gl::DebugGroup group("bundle pass");
+    // per direction and leaf, never per tile: tiles change with the budget, the bits must not
+    const uint32_t leafSeed = pcgHash(seed_ ^ pcgHash(uint32_t(tile.leaf) * 7919u + 17u));
+    const uint32_t endOfList = END_OF_LIST, zero[2] = {0, 0};
+    glClearTexSubImage(heads_.id(), 0, f.headOrigin.x, f.headOrigin.y, 0, f.drawn.width, f.drawn.height, 1,
+                       GL_RED_INTEGER, GL_UNSIGNED_INT, &endOfList);
+    if (resetCounter) glNamedBufferSubData(counter_.id(), 0, 8, zero);
+    glUseProgram(append_.id());
+    setFrameUniforms(append_.id(), f);
+    glUniform1ui(append_.uniform("nodeCapacity"), uint32_t(nodeAllocated_));
+    glUniform1ui(append_.uniform("randomSeed"), leafSeed);
+    glUniform1i(append_.uniform("backLayerOffset"), scene_.backLayerOffset);
+    // the leaf's grid in a power-of-two viewport (glsl/bundle/append.vert) shifted so the
+    // drawn window (the tile and its apron) lands at its place in the head image; the scissor keeps the rest out
+    int viewportPixels = 1;
+    while (viewportPixels < f.leaf.pixels) viewportPixels *= 2;
+    glUniform1i(append_.uniform("viewportPixels"), viewportPixels);
+    glUniform1f(append_.uniform("subpixelSteps"), float(1 << limits_.subpixelBits));
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
+    glViewport(f.headOrigin.x - f.drawn.x, f.headOrigin.y - f.drawn.y, viewportPixels, viewportPixels);
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(f.headOrigin.x, f.headOrigin.y, f.drawn.width, f.drawn.height);
+    glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, BINDING_NODE_COUNTER, counter_.id());
+    glBindImageTexture(BINDING_HEADS, heads_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+    glBindTextureUnit(BINDING_RADIANCE, scene_.radiance);
+    glBindTextureUnit(BINDING_READ_MODES, scene_.readModes);
+    glBindTextureUnit(BINDING_TEXEL_CHARTS, scene_.texelCharts);
+    drawClusters(append_.id(), tile.clusters, false);
+    glDisable(GL_SCISSOR_TEST);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_ATOMIC_COUNTER_BARRIER_BIT |
+                    GL_BUFFER_UPDATE_BARRIER_BIT);
+}
+
+void BundleTracer::runUpdate(const UpdateFn& update, const TileFrame& f, uint32_t nodeCount,
+                             const std::vector<uint32_t>& clusters) {
+    auto tu = Clock::now();
+    gl::DebugGroup group("update pass");
+    glBindFramebuffer(GL_FRAMEBUFFER, scene_.pageFramebuffer);
+    glViewport(0, 0, scene_.pageResolution, scene_.pageResolution);
+    const UpdatePrograms programs = update(f, nodeCount);
+    glBindImageTexture(BINDING_HEADS, heads_.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
+    if (f.allLeaves) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_LEAF_TABLE, leafTable_.id());
+    // the two draws update disjoint texels (update.frag leaves curved ones to the second)
+    for (GLuint program : {programs.triangles, programs.curved}) {
+        if (!program) continue;
+        glUseProgram(program);
+        setFrameUniforms(program, f);
+        glUniform1ui(glGetUniformLocation(program, "nodeCount"), nodeCount);
+        if (f.allLeaves) glUniform1i(glGetUniformLocation(program, "leafCount"), int(leafRecords_.size()));
+        if (program == programs.triangles)
+            drawClusters(program, clusters, true);
+        else
+            drawCurvedTexels(program, clusters);
+    }
+    if (programs.triangles || programs.curved)
+        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+    if (recordStats_) {
+        glFinish();
+        stats_->secondsUpdate += secondsSince(tu);
+    }
 }
 
 }  // namespace bb

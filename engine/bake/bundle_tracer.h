@@ -5,6 +5,15 @@
 // update pass (the caller's program) that draws the tile's receiving
 // clusters in light map space.
 //
+// When all of a direction's tiles are whole leaves and their lists fit the
+// buffers together (the predictions, and the leaves' grids side by side in
+// one head image), and the caller has programs for it, the tiles are drawn
+// one after another into the same buffers and one update over all leaves
+// follows the last (update.frag LEAF_TABLE): each texel is drawn once a
+// direction instead of once for each tile its cluster meets. A draw that
+// overflows there starts the direction again tile by tile. Either way each
+// texel takes the same sample: the same bits.
+//
 // Memory: the node buffer and the head image start small and grow to what
 // the tiles predict (a quarter of margin), never past the budget's limits.
 // A tile whose counter exceeds the buffer is redrawn into a buffer of the
@@ -22,6 +31,7 @@
 
 #include "bake/baker.h"
 #include "core/status.h"
+#include "glsl/shared/bundle_layout.h"
 #include "gl/objects.h"
 #include "layout/bake_mesh_gl.h"
 #include "tiler/tiler.h"
@@ -37,7 +47,9 @@ struct TileFrame {
     BundleLeaf leaf;
     TileWindow window;  // the pixels the tile owns
     TileWindow drawn;   // and the pixels it draws: with a one-pixel apron (tiler.h drawnWindow)
+    glm::ivec2 headOrigin{0};  // where the drawn window's first pixel lies in the head image
     float pixelSize = 1.0f;
+    bool allLeaves = false;  // the update over all of the direction's leaves (leaf, window: unused)
 };
 
 // Sets the bundle_frame.glsl uniforms of `program` (bound).
@@ -80,7 +92,8 @@ public:
         GLuint triangles = 0, curved = 0;
     };
     // Sets the update programs' uniforms (other than the frame's, the node
-    // count and pageResolution, which the tracer sets) and returns them.
+    // count and pageResolution, which the tracer sets) and returns them: for
+    // frame.allLeaves, the programs built with LEAF_TABLE.
     using UpdateFn = std::function<UpdatePrograms(const TileFrame&, uint32_t nodeCount)>;
 
     // Curved texels (bake/curved_footprints.h) for the updates: per cluster,
@@ -98,14 +111,16 @@ public:
 
     // Tiles a direction: the clusters projected along frame.dir, the leaves
     // and tiles of tileBundle. recordStats: the direction counts in BakeStats
-    // (bakes; not the sun or captures).
-    void begin(const BundleFrame& frame, const TilerOptions& options, uint32_t seed, bool recordStats);
+    // (bakes; not the sun or captures). allLeaves: the update may be one over
+    // all leaves (the update function has LEAF_TABLE programs).
+    void begin(const BundleFrame& frame, const TilerOptions& options, uint32_t seed, bool recordStats,
+               bool allLeaves = false);
     bool done() const { return work_.empty(); }
     // Draws the next tile (one bundle draw) and, if it fit, its update.
     void next(const UpdateFn& update);
     // All of a direction's tiles.
     void run(const BundleFrame& frame, const TilerOptions& options, uint32_t seed, bool recordStats,
-             const UpdateFn& update);
+             const UpdateFn& update, bool allLeaves = false);
 
     // The latest direction's tiling (viewer overlays) and the latest tile's
     // lists (captures: head image row stride headSide()).
@@ -123,6 +138,9 @@ private:
     void ensureHeads(int side);
     void drawClusters(GLuint program, const std::vector<uint32_t>& ids, bool receiversOnly);
     void drawCurvedTexels(GLuint program, const std::vector<uint32_t>& ids);
+    bool planAllLeaves();  // whether the direction's update can be one over all leaves (and where they go)
+    void drawBundle(const Tile& tile, const TileFrame& f, bool resetCounter);
+    void runUpdate(const UpdateFn& update, const TileFrame& f, uint32_t nodeCount, const std::vector<uint32_t>& clusters);
 
     BundleScene scene_;
     BundleLimits limits_;
@@ -148,6 +166,20 @@ private:
     bool recordStats_ = false;
     int tiles_ = 0;
     uint32_t lastCount_ = 0;
+    // one update over all leaves (planAllLeaves): each tile's place in the head
+    // image, the leaf table, what the tiles drawn so far hold, and their counts
+    bool allLeaves_ = false;
+    std::vector<glm::ivec2> headOrigins_;
+    std::vector<shared::LeafRecord> leafRecords_;
+    gl::Buffer leafTable_;
+    std::vector<uint32_t> drawnClusters_;
+    uint32_t drawnNodes_ = 0, drawnOwned_ = 0;
+    struct DrawnTile {
+        double predicted;
+        uint32_t nodes, owned;
+        float pixelSize;
+    };
+    std::vector<DrawnTile> drawnTiles_;
 };
 
 }  // namespace bb

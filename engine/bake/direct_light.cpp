@@ -100,8 +100,10 @@ void Baker::Impl::bakeSun() {
     for (size_t li = 0; li < lights.size(); ++li) {
         const glm::vec3 irradiance = lights[li].irradiance / radianceUnit;
         uint32_t footprintSample = 0;  // the jitter's index: each one samples another point of every texel's footprint
-        const BundleTracer::UpdateFn update = [&](const TileFrame&, uint32_t) {
-            for (const gl::Program* program : {&sunProgram, &sunCurvedProgram}) {
+        const BundleTracer::UpdateFn update = [&](const TileFrame& f, uint32_t) {
+            const gl::Program& triangles = f.allLeaves ? sunAllLeavesProgram : sunProgram;
+            const gl::Program& curved = f.allLeaves ? sunCurvedAllLeavesProgram : sunCurvedProgram;
+            for (const gl::Program* program : {&triangles, &curved}) {
                 glUseProgram(program->id());
                 glUniform3fv(program->uniform("sunIrradiance"), 1, &irradiance.x);
                 glUniform1f(program->uniform("depthBias"), depthBias);
@@ -110,14 +112,14 @@ void Baker::Impl::bakeSun() {
             glBindTextureUnit(BINDING_FOOTPRINT, footprint.id());
             bindDirectSums(*this);
             glBindImageTexture(BINDING_DIRECT, direct.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA16F);
-            return BundleTracer::UpdatePrograms{sunProgram.id(), curvedTexelCount() ? sunCurvedProgram.id() : 0u};
+            return BundleTracer::UpdatePrograms{triangles.id(), curvedTexelCount() ? curved.id() : 0u};
         };
         for (int jy = 0; jy < j; ++jy)
             for (int jx = 0; jx < j; ++jx) {
                 const glm::vec2 jitter((jx + 0.5f) / j - 0.5f, (jy + 0.5f) / j - 0.5f);
                 footprintSample = uint32_t(jy * j + jx);
                 tracer->run(bundleFrame(glm::normalize(lights[li].direction), jitter, sunOptions.uniform, jitterUnit),
-                            sunOptions, uint32_t(li * 1000 + jy * j + jx), false, update);
+                            sunOptions, uint32_t(li * 1000 + jy * j + jx), false, update, true);
             }
         foldDirect(true);  // this sun's mean over its valid samples, added to the direct map
     }

@@ -31,10 +31,12 @@ void Baker::Impl::beginDirection(int k) {
         sampleWeight = 1.0;
     }
     const uint32_t seed = pcgHash(uint32_t(options.seed) * 0x9E3779B1u ^ pcgHash(uint32_t(k)));
-    directionUpdate = [this, sampleWeight, seed, k](const TileFrame&, uint32_t) {
+    directionUpdate = [this, sampleWeight, seed, k](const TileFrame& f, uint32_t) {
         const bool useEnv = bool(envTexture);
         const glm::vec3 sky = options.sky / radianceUnit;
-        for (const gl::Program* program : {&updateProgram, &updateCurvedProgram}) {
+        const gl::Program& triangles = f.allLeaves ? updateAllLeavesProgram : updateProgram;
+        const gl::Program& curved = f.allLeaves ? updateCurvedAllLeavesProgram : updateCurvedProgram;
+        for (const gl::Program* program : {&triangles, &curved}) {
             glUseProgram(program->id());
             glUniform1f(program->uniform("sampleWeight"), float(sampleWeight));
             // per direction, not per tile: each texel is updated once per direction, and tiles change with the budget
@@ -54,13 +56,13 @@ void Baker::Impl::beginDirection(int k) {
         glBindTextureUnit(BINDING_FOOTPRINT, footprint.id());
         if (useEnv) glBindTextureUnit(BINDING_ENV, envTexture.id());
         glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
-        return BundleTracer::UpdatePrograms{updateProgram.id(), curvedTexelCount() ? updateCurvedProgram.id() : 0u};
+        return BundleTracer::UpdatePrograms{triangles.id(), curvedTexelCount() ? curved.id() : 0u};
     };
     // the grid's phase, random per direction: where the bundle grid beats against
     // the light map's texels, the pattern moves from direction to direction and
     // averages out instead of settling into stripes (issue 11)
     const glm::vec2 phase(uniform01(pcgHash(seed ^ 0x5bd1e995u)) - 0.5f, uniform01(pcgHash(seed ^ 0x1b873593u)) - 0.5f);
-    tracer->begin(bundleFrame(d, phase, tilerOptions.uniform, pixelSize), tilerOptions, seed, true);
+    tracer->begin(bundleFrame(d, phase, tilerOptions.uniform, pixelSize), tilerOptions, seed, true, true);
     directionActive = true;
 }
 

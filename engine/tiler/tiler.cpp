@@ -327,6 +327,35 @@ Tile makeTile(const DirectionTiling& tiling, int leaf, const TileWindow& window,
     return t;
 }
 
+std::vector<glm::ivec2> packSquares(const std::vector<int>& sides, int maxSide, int& side) {
+    std::vector<size_t> order(sides.size());
+    std::iota(order.begin(), order.end(), size_t(0));
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return sides[a] > sides[b]; });
+    const int largest = sides.empty() ? 1 : sides[order[0]];
+    for (side = 1; side < largest;) side *= 2;
+    for (; side <= maxSide; side *= 2) {
+        std::vector<glm::ivec2> origins(sides.size());
+        int x = 0, y = 0, shelf = 0;  // the shelf's height: its first (largest) square's side
+        bool fits = true;
+        for (size_t i : order) {
+            if (x + sides[i] > side) {
+                x = 0;
+                y += shelf;
+                shelf = 0;
+            }
+            if (shelf == 0) shelf = sides[i];
+            if (y + sides[i] > side) {
+                fits = false;
+                break;
+            }
+            origins[i] = {x, y};
+            x += sides[i];
+        }
+        if (fits) return origins;
+    }
+    return {};
+}
+
 std::vector<TileWindow> splitWindow(const TileWindow& w) {
     std::vector<TileWindow> out;
     const int hw = std::max(1, w.width / 2), hh = std::max(1, w.height / 2);

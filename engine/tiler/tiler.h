@@ -151,6 +151,13 @@ DirectionTiling tileBundle(const std::vector<Cluster>& clusters, const std::vect
 Tile makeTile(const DirectionTiling& tiling, int leaf, const TileWindow& window, const std::vector<Cluster>& clusters,
               const std::vector<ClusterView>& views, const std::vector<uint32_t>& candidates, bool cull);
 
+// Places squares of the given sides (pixels) without overlap in one square
+// image of side `side` (a power of two, the least that holds them, at most
+// maxSide): shelves of the largest first, in a fixed order. Returns their
+// lower-left corners, or nothing when they do not fit in maxSide^2. Used to
+// hold all of a direction's leaves' head pointers at once (bundle_tracer.h).
+std::vector<glm::ivec2> packSquares(const std::vector<int>& sides, int maxSide, int& side);
+
 // The four quarters of a window (fewer when it is one pixel wide or high).
 std::vector<TileWindow> splitWindow(const TileWindow& window);
 

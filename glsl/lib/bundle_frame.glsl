@@ -13,17 +13,25 @@ uniform vec3 bundleU;
 uniform vec3 bundleV;
 uniform vec2 rootOrigin;     // (u, v) of the root square's lower-left corner, scene units
 uniform float rootSize;      // the root square's side, scene units
-uniform vec2 leafMin;        // the leaf's lower-left corner, root units
-uniform float leafExtent;    // the leaf's side, root units
-uniform int leafPixels;      // pixels across the leaf
-uniform float pixelSize;     // scene units per pixel of this leaf
-uniform ivec2 tileOffset;    // the drawn window's first pixel in the leaf's grid (the head image's origin)
-uniform ivec2 tileSize;      // the drawn window's pixels: the tile's own and a one-pixel apron within the leaf
-uniform ivec4 ownedPixels;   // the tile's own pixels in the head image: [xy, zw)
+// The leaf's and the tile's parameters: uniforms, or (LEAF_TABLE: one update
+// over all of a direction's leaves, lightmap/update.frag) set per fragment
+// from the leaf that holds its texel.
+#ifdef LEAF_TABLE
+#define LEAF_PARAM
+#else
+#define LEAF_PARAM uniform
+#endif
+LEAF_PARAM vec2 leafMin;        // the leaf's lower-left corner, root units
+LEAF_PARAM float leafExtent;    // the leaf's side, root units
+LEAF_PARAM int leafPixels;      // pixels across the leaf
+LEAF_PARAM float pixelSize;     // scene units per pixel of this leaf
+LEAF_PARAM ivec2 tileOffset;    // the leaf grid's pixel at the head image's origin (the drawn window's first, or minus the leaf's place in an atlas)
+LEAF_PARAM ivec4 drawnPixels;   // the pixels the tile draws in the head image: [xy, zw) (its own and a one-pixel apron within the leaf)
+LEAF_PARAM ivec4 ownedPixels;   // the tile's own pixels in the head image: [xy, zw)
 
 // Whether head-image pixel p is the tile's own, or drawn at all (own or apron).
 bool ownedPixel(ivec2 p) { return all(greaterThanEqual(p, ownedPixels.xy)) && all(lessThan(p, ownedPixels.zw)); }
-bool drawnPixel(ivec2 p) { return all(greaterThanEqual(p, ivec2(0))) && all(lessThan(p, tileSize)); }
+bool drawnPixel(ivec2 p) { return all(greaterThanEqual(p, drawnPixels.xy)) && all(lessThan(p, drawnPixels.zw)); }
 
 vec3 bundleFromWorld(vec3 p) { return vec3(dot(p, bundleU), dot(p, bundleV), dot(p, bundleDir)); }
 

@@ -77,6 +77,37 @@ layout(binding = BINDING_FOOTPRINT) uniform usampler2DArray footprint;
 
 const float PI = 3.14159265358979;
 
+#ifdef LEAF_TABLE
+// One update over all of a direction's leaves (engine/bake/bundle_tracer.h):
+// each leaf's lists at its place in one head image, the leaves in a table.
+layout(std430, binding = BINDING_LEAF_TABLE) readonly buffer Leaves { LeafRecord leafTable[]; };
+uniform int leafCount;
+
+// The leaf whose square holds q (root units) becomes the frame's
+// (bundle_frame.glsl): the same float bounds as a tile's uniforms, so the same
+// leaf takes the point either way. False: no leaf with receivers does.
+bool takeLeaf(vec2 q) {
+    for (int i = 0; i < leafCount; ++i) {
+        LeafRecord l = leafTable[i];
+        vec2 lo = vec2(l.minX, l.minY);
+        if (all(greaterThanEqual(q, lo)) && all(lessThan(q, lo + vec2(l.extent)))) {
+            leafMin = lo;
+            leafExtent = l.extent;
+            leafPixels = l.pixels;
+            pixelSize = l.pixelSize;
+            ivec2 origin = ivec2(l.originX, l.originY);
+            tileOffset = -origin;
+            ownedPixels = drawnPixels = ivec4(origin, origin + ivec2(l.pixels));
+            return true;
+        }
+    }
+    return false;
+}
+#else
+// The tile's leaf holds q (root units): the tile's frame is the uniforms'.
+bool takeLeaf(vec2 q) { return leafOwns(q); }
+#endif
+
 vec3 environment(vec3 dir) {
 #ifndef SUN_PASS
     if (useEnv) {
@@ -287,7 +318,7 @@ bool planeSample(FlatFrame f, ivec3 texel, vec3 leafPoint, out TexelSample s) {
     s.texel = texel;
     // the leaf of the texel's centre takes its sample (a sample whose point
     // lies in another leaf is lost, at random: leaves move with d)
-    if (!leafOwns(rootFromBundle(bundleFromWorld(leafPoint).xy))) return false;
+    if (!takeLeaf(rootFromBundle(bundleFromWorld(leafPoint).xy))) return false;
     vec2 centreRoot = rootFromBundle(bundleFromWorld(f.position).xy);
 #ifdef SUN_PASS
     uint pixelSeed = pcgHash(footprintSample + 0x632be5abu);
@@ -352,7 +383,7 @@ bool curvedSample(out TexelSample s) {
     }
     s.texel = texel;
     // the leaf of the texel's centre takes its sample, as on flat texels
-    if (!leafOwns(rootFromBundle(bundleFromWorld(curvedTexelCentre(vCurved)).xy))) return false;
+    if (!takeLeaf(rootFromBundle(bundleFromWorld(curvedTexelCentre(vCurved)).xy))) return false;
     vec2 point;
     CurvedTriangle tri;
     curvedFootprintPoint(vCurved, texelFetch(footprint, s.texel, 0).xy, footprintSample, point, tri);

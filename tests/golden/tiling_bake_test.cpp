@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <numeric>
 #include <string>
 
 #include "support/bake_helper.h"
@@ -26,9 +27,9 @@ struct Baked {
     std::string error;
 };
 
-Baked bakeCity(const std::string& path, const BakeOptions& options) {
+Baked bakeCity(const std::string& path, const BakeOptions& options, const LayoutOptions& layout = cityLayout()) {
     Baked out;
-    SceneBake bake = makeBake(path, cityLayout(), options);
+    SceneBake bake = makeBake(path, layout, options);
     if (!bake) {
         out.error = bake.error;
         return out;
@@ -131,6 +132,37 @@ TEST(TilingBake, SteppingByTileGivesTheSameBits) {
     EXPECT_GT(callsMidDirection, 0);
     EXPECT_EQ(tiled.stats.tilesDrawn, whole.stats.tilesDrawn);
     EXPECT_EQ(differingTexels(whole, tiled), 0u);
+}
+
+// Where a direction's tiles are whole leaves and their lists fit the buffers
+// together, one update pass over all the leaves follows the last tile
+// (bundle_tracer.h): each texel is drawn once a direction instead of once for
+// each tile its cluster meets. mixed_lighting's curved furniture cuts its
+// directions into ~20 leaves. With a head image too small to hold them side
+// by side the update goes tile by tile: the same bits, more triangles drawn.
+TEST(TilingBake, OneUpdateOverAllLeavesGivesTheSameBits) {
+    BB_REQUIRE_GL();
+    const std::string scene = sourcePath("assets/shared/mixed_lighting/MixedLightingExample.gltf");
+    BakeOptions o = skyOptions(6, 2);
+    o.supersample = 2;  // as the CLI's auto: the texels the curvature refinement cuts the leaves for
+    const Baked together = bakeCity(scene, o, packLayout(64));
+    ASSERT_TRUE(together.error.empty()) << together.error;
+    o.bundleMemory = (int64_t(1) << 20) - 1;  // a head image of 128^2 (a quarter of it at most), 81919 nodes
+    const Baked apart = bakeCity(scene, o, packLayout(64));
+    ASSERT_TRUE(apart.error.empty()) << apart.error;
+    std::printf("[tiling] mixed_lighting: %.1f leaves a direction; %lld of %d directions updated at once, update "
+                "triangles drawn %lld (at once) / %lld (tile by tile), tiles %lld / %lld, nodes at most %lld / %lld\n",
+                double(std::accumulate(together.stats.leavesPerDirection.begin(), together.stats.leavesPerDirection.end(), 0)) /
+                    double(std::max<size_t>(together.stats.leavesPerDirection.size(), 1)),
+                (long long)together.stats.allLeavesUpdates, together.stats.directionsDone,
+                (long long)together.stats.updateTrianglesDrawn, (long long)apart.stats.updateTrianglesDrawn,
+                (long long)together.stats.tilesDrawn, (long long)apart.stats.tilesDrawn,
+                (long long)together.stats.peakNodesPerTile, (long long)apart.stats.peakNodesPerTile);
+    EXPECT_GT(together.stats.allLeavesUpdates, 0);
+    EXPECT_EQ(apart.stats.allLeavesUpdates, 0);
+    EXPECT_LT(2 * together.stats.updateTrianglesDrawn, apart.stats.updateTrianglesDrawn);
+    EXPECT_EQ(together.stats.fragments, apart.stats.fragments);
+    EXPECT_EQ(differingTexels(together, apart), 0u);
 }
 
 // The projected-area prediction per tile on three generated sizes, cut into
