@@ -300,5 +300,29 @@ TEST(Tiler, CullingKeepsOnlyClustersThatMeetTheTile) {
     EXPECT_EQ(count[0], int32_t(3 * mesh.triangles.size()));
 }
 
+// A direction's leaves side by side in one head image (one update over all of
+// them, bundle_tracer.h): inside the image, no two overlapping, the image the
+// least power of two that holds them; nothing when the limit cannot.
+TEST(Tiler, PackedSquaresDoNotOverlapAndFitTheLeastPowerOfTwo) {
+    const std::vector<int> sides = {100, 512, 37, 256, 256, 0, 64, 300, 1};
+    int side = 0;
+    const std::vector<glm::ivec2> at = packSquares(sides, 2048, side);
+    ASSERT_EQ(at.size(), sides.size());
+    EXPECT_EQ(side, 1024);  // their area (~499000 pixels) is more than 512^2
+    for (size_t i = 0; i < sides.size(); ++i) {
+        EXPECT_GE(at[i].x, 0);
+        EXPECT_GE(at[i].y, 0);
+        EXPECT_LE(at[i].x + sides[i], side);
+        EXPECT_LE(at[i].y + sides[i], side);
+        for (size_t j = 0; j < i; ++j) {
+            const bool apart = at[i].x + sides[i] <= at[j].x || at[j].x + sides[j] <= at[i].x ||
+                               at[i].y + sides[i] <= at[j].y || at[j].y + sides[j] <= at[i].y;
+            EXPECT_TRUE(apart || sides[i] == 0 || sides[j] == 0) << i << " overlaps " << j;
+        }
+    }
+    EXPECT_TRUE(packSquares(sides, 512, side).empty());
+    EXPECT_TRUE(packSquares({600}, 512, side).empty());
+}
+
 }  // namespace
 }  // namespace bb
