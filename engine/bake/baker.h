@@ -63,6 +63,9 @@ struct BakeOptions {
     // from the predictions. false: the buffer is allocated at the budget and
     // only overflow detection splits tiles (tests).
     bool predictTiles = true;
+    // Update runs of whole leaves at once (bundle_tracer.h). false: every tile
+    // alone (tests: the same bits).
+    bool leafRuns = true;
     // Sun bundles per axis, each jittered sub-pixel and at another point of
     // every texel's footprint (antialiased shadows: a texel across a shadow
     // edge reads its lit fraction in steps of 1 / sunJitter^2). 0 = from the
@@ -108,7 +111,7 @@ struct BakeStats {
     double transportAlbedo = 0;       // the light's share kept per bounce (bake/transport_albedo.h)
     double radianceUnit = 1;          // the light-map state holds radiance / this (a power of two; fp16 range)
     int64_t tilesDrawn = 0;
-    int64_t allLeavesUpdates = 0;     // directions updated in one pass over all their leaves (bundle_tracer.h)
+    int64_t leafRunUpdates = 0;       // update passes over a run of several whole leaves at once (bundle_tracer.h)
     int64_t overflows = 0;            // tile draws whose node count exceeded the buffer: redrawn (bigger buffer, or split)
     int64_t fragments = 0;            // nodes appended (kept) for the tiles' own pixels, over all tiles
     int64_t updatedTexels = 0;        // texel samples accumulated

@@ -101,8 +101,8 @@ struct Baker::Impl {
     }
     gl::Texture envTexture;
     gl::Framebuffer pageFbo;
-    // the update's programs over one tile, and over all of a direction's leaves at once (bundle_tracer.h)
-    gl::Program updateAllLeavesProgram, updateCurvedAllLeavesProgram, sunAllLeavesProgram, sunCurvedAllLeavesProgram;
+    // the update's programs over one tile, and over a run of whole leaves at once (bundle_tracer.h)
+    gl::Program updateLeafRunProgram, updateCurvedLeafRunProgram, sunLeafRunProgram, sunCurvedLeafRunProgram;
     gl::Program updateProgram, sunProgram, updateCurvedProgram, sunCurvedProgram, resolveProgram, rescaleProgram, metaProgram, coverageProgram,
         dilateProgram, readModesProgram, directFoldProgram, distanceProgram, emitterProgram, emitterCurvedProgram,
         emitterFoldProgram, punctualProgram, punctualCurvedProgram,

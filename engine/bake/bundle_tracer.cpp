@@ -117,41 +117,69 @@ void drawCurvedTexelRuns(GLuint program, int res, const std::vector<int32_t>& fi
         }
 }
 
-bool BundleTracer::planAllLeaves() {
+void BundleTracer::planGroups() {
     const std::vector<Tile>& tiles = tiling_.tiles;
-    if (tiles.size() < 2) return false;
-    std::vector<int> sides(tiling_.leaves.size(), 0);
+    leafGroup_.assign(tiling_.leaves.size(), -1);
+    leafOrigin_.assign(tiling_.leaves.size(), glm::ivec2(0));
+    groups_.clear();
+    const auto nodesFor = [](double predicted) { return int64_t(std::ceil(1.25 * predicted)) + 1024; };
+    // the open run: tiles [first, i), their predicted nodes, their leaves' sides and places
+    size_t first = 0;
     double predicted = 0;
-    for (const Tile& t : tiles) {
-        const int pixels = tiling_.leaves[size_t(t.leaf)].pixels;
-        if (t.window.x != 0 || t.window.y != 0 || t.window.width != pixels || t.window.height != pixels) return false;
-        sides[size_t(t.leaf)] = pixels;
-        predicted += t.predictedNodes;
-    }
-    const int64_t nodes = int64_t(std::ceil(1.25 * predicted)) + 1024;
-    if (nodes > limits_.nodeCapacity) return false;
+    std::vector<int> sides;
+    std::vector<glm::ivec2> origins;
     int side = 0;
-    headOrigins_ = packSquares(sides, limits_.maxTileSize, side);  // leaves without a tile take no room
-    if (headOrigins_.empty()) return false;
-    if (limits_.predict) ensureNodes(nodes);
-    ensureHeads(side);
-    leafRecords_.clear();
-    for (const Tile& t : tiles) {
-        const BundleLeaf& l = tiling_.leaves[size_t(t.leaf)];
-        const glm::ivec2 o = headOrigins_[size_t(t.leaf)];
-        leafRecords_.push_back({float(l.min.x), float(l.min.y), float(l.extent), l.pixels,
-                                float(tiling_.pixelSize(t.leaf)), o.x, o.y, 0});
+    const auto close = [&](size_t end) {
+        if (end - first >= 2) {  // one tile alone is updated as before
+            Group g;
+            g.nodes = nodesFor(predicted);
+            g.side = side;
+            for (size_t k = first; k < end; ++k) {
+                const int leaf = tiles[k].leaf;
+                const BundleLeaf& l = tiling_.leaves[size_t(leaf)];
+                const glm::ivec2 o = origins[k - first];
+                leafGroup_[size_t(leaf)] = int(groups_.size());
+                leafOrigin_[size_t(leaf)] = o;
+                g.records.push_back({float(l.min.x), float(l.min.y), float(l.extent), l.pixels,
+                                     float(tiling_.pixelSize(leaf)), o.x, o.y, 0});
+            }
+            groups_.push_back(std::move(g));
+        }
+        first = end;
+        predicted = 0;
+        sides.clear();
+        origins.clear();
+    };
+    for (size_t i = 0; i < tiles.size(); ++i) {
+        const Tile& t = tiles[i];
+        const int pixels = tiling_.leaves[size_t(t.leaf)].pixels;
+        if (t.window.x != 0 || t.window.y != 0 || t.window.width != pixels || t.window.height != pixels) {
+            close(i);  // a leaf the budget cut: its tiles alone
+            first = i + 1;
+            continue;
+        }
+        for (int pass = 0; pass < 2; ++pass) {  // into the open run, or (if it does not fit there) a new one
+            sides.push_back(pixels);
+            std::vector<glm::ivec2> placed;
+            int placedSide = 0;
+            if (nodesFor(predicted + t.predictedNodes) <= limits_.nodeCapacity)
+                placed = packSquares(sides, limits_.maxTileSize, placedSide);
+            if (!placed.empty()) {
+                origins = std::move(placed);
+                side = placedSide;
+                predicted += t.predictedNodes;
+                break;
+            }
+            sides.pop_back();
+            close(i);
+            if (pass == 1) first = i + 1;  // too large for a run of its own: alone
+        }
     }
-    const int64_t bytes = int64_t(leafRecords_.size() * sizeof(shared::LeafRecord));
-    if (leafTable_.bytes() < bytes)
-        leafTable_ = gl::Buffer::create("bundle leaf table", std::max<int64_t>(bytes, 64 * int64_t(sizeof(shared::LeafRecord))),
-                                        nullptr, GL_DYNAMIC_STORAGE_BIT);
-    glNamedBufferSubData(leafTable_.id(), 0, bytes, leafRecords_.data());
-    return true;
+    close(tiles.size());
 }
 
 void BundleTracer::begin(const BundleFrame& frame, const TilerOptions& options, uint32_t seed, bool recordStats,
-                         bool allLeaves) {
+                         bool leafRuns) {
     auto t0 = Clock::now();
     frame_ = frame;
     options_ = options;
@@ -163,8 +191,13 @@ void BundleTracer::begin(const BundleFrame& frame, const TilerOptions& options, 
     tiles_ = 0;
     drawnTiles_.clear();
     drawnClusters_.clear();
-    drawnNodes_ = drawnOwned_ = 0;
-    allLeaves_ = allLeaves && planAllLeaves();
+    groupTiles_.clear();
+    if (leafRuns) {
+        planGroups();
+    } else {
+        leafGroup_.assign(tiling_.leaves.size(), -1);
+        groups_.clear();
+    }
     if (recordStats) {
         stats_->secondsTiling += secondsSince(t0);
         stats_->leavesPerDirection.push_back(int(tiling_.leaves.size()));
@@ -173,8 +206,8 @@ void BundleTracer::begin(const BundleFrame& frame, const TilerOptions& options, 
 }
 
 void BundleTracer::run(const BundleFrame& frame, const TilerOptions& options, uint32_t seed, bool recordStats,
-                       const UpdateFn& update, bool allLeaves) {
-    begin(frame, options, seed, recordStats, allLeaves);
+                       const UpdateFn& update, bool leafRuns) {
+    begin(frame, options, seed, recordStats, leafRuns);
     while (!done()) next(update);
 }
 
@@ -192,8 +225,21 @@ void BundleTracer::next(const UpdateFn& update) {
     f.window = tile.window;
     f.drawn = drawnWindow(tile.window, f.leaf.pixels);
     f.pixelSize = float(tiling_.pixelSize(tile.leaf));
-    if (allLeaves_) {
-        f.headOrigin = headOrigins_[size_t(tile.leaf)];
+    // whole leaves of a run updated at once (planGroups) share the buffers: the counts are the run's so far
+    const int group = leafGroup_[size_t(tile.leaf)];
+    const bool firstOfRun = group < 0 || groupTiles_.empty();
+    if (group >= 0) {
+        f.headOrigin = leafOrigin_[size_t(tile.leaf)];
+        if (firstOfRun) {
+            const Group& g = groups_[size_t(group)];
+            if (limits_.predict) ensureNodes(g.nodes);
+            ensureHeads(g.side);
+            const int64_t bytes = int64_t(g.records.size() * sizeof(shared::LeafRecord));
+            if (leafTable_.bytes() < bytes)
+                leafTable_ = gl::Buffer::create("bundle leaf table", std::max<int64_t>(bytes, 4096), nullptr,
+                                                GL_DYNAMIC_STORAGE_BIT);
+            glNamedBufferSubData(leafTable_.id(), 0, bytes, g.records.data());
+        }
     } else {
         // buffers sized from the prediction (a quarter of margin), within the budget
         if (limits_.predict) ensureNodes(int64_t(std::ceil(1.25 * tile.predictedNodes)) + 1024);
@@ -209,8 +255,7 @@ void BundleTracer::next(const UpdateFn& update) {
     }
 
     auto tb = Clock::now();
-    // with one update over all leaves the tiles append to the same buffer: the counts are the direction's so far
-    drawBundle(tile, f, !allLeaves_ || drawnTiles_.empty());
+    drawBundle(tile, f, firstOfRun);
     uint32_t counts[2] = {0, 0};
     glGetNamedBufferSubData(counter_.id(), 0, 8, counts);
     const uint32_t count = counts[0];
@@ -223,9 +268,11 @@ void BundleTracer::next(const UpdateFn& update) {
     if (int64_t(count) > nodeAllocated_) {
         // overflow: nothing is used from this draw.
         if (recordStats_) ++stats_->overflows;
-        if (allLeaves_) {  // nothing updated yet: the direction again, tile by tile
-            allLeaves_ = false;
-            work_.assign(tiling_.tiles.rbegin(), tiling_.tiles.rend());
+        if (group >= 0) {  // nothing of the run updated yet: its tiles again, each alone
+            std::replace(leafGroup_.begin(), leafGroup_.end(), group, -1);
+            work_.push_back(std::move(tile));
+            for (auto it = groupTiles_.rbegin(); it != groupTiles_.rend(); ++it) work_.push_back(std::move(*it));
+            groupTiles_.clear();
             drawnTiles_.clear();
             drawnClusters_.clear();
             return;
@@ -242,16 +289,18 @@ void BundleTracer::next(const UpdateFn& update) {
         }
         return;
     }
-    const uint32_t before = allLeaves_ ? drawnNodes_ : 0u, ownedBefore = allLeaves_ ? drawnOwned_ : 0u;
+    const uint32_t before = firstOfRun ? 0u : drawnNodes_, ownedBefore = firstOfRun ? 0u : drawnOwned_;
     drawnTiles_.push_back({tile.predictedNodes, count - before, counts[1] - ownedBefore, f.pixelSize});
-    if (allLeaves_) {
-        drawnNodes_ = count;
-        drawnOwned_ = counts[1];
+    drawnNodes_ = count;
+    drawnOwned_ = counts[1];
+    if (group >= 0) {
         drawnClusters_.insert(drawnClusters_.end(), tile.clusters.begin(), tile.clusters.end());
-        if (!work_.empty()) return;  // the update follows the last tile
+        groupTiles_.push_back(std::move(tile));
+        if (groupTiles_.size() < groups_[size_t(group)].records.size()) return;  // the update follows the run's last tile
         std::sort(drawnClusters_.begin(), drawnClusters_.end());
         drawnClusters_.erase(std::unique(drawnClusters_.begin(), drawnClusters_.end()), drawnClusters_.end());
-        f.allLeaves = true;
+        f.leafRun = true;
+        activeGroup_ = group;
     }
     if (recordStats_) {
         for (const DrawnTile& t : drawnTiles_) {
@@ -260,10 +309,12 @@ void BundleTracer::next(const UpdateFn& update) {
             stats_->tilePixelSizes.push_back(t.pixelSize);
         }
         stats_->peakNodesPerTile = std::max<int64_t>(stats_->peakNodesPerTile, count);  // what the buffer held
-        stats_->allLeavesUpdates += f.allLeaves;
+        stats_->leafRunUpdates += f.leafRun;
     }
     drawnTiles_.clear();
-    if (count > 0) runUpdate(update, f, count, f.allLeaves ? drawnClusters_ : tile.clusters);
+    if (count > 0) runUpdate(update, f, count, f.leafRun ? drawnClusters_ : tile.clusters);
+    drawnClusters_.clear();
+    groupTiles_.clear();
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     if (recordStats_ && work_.empty()) stats_->tilesPerDirection.push_back(tiles_);
 }
@@ -310,14 +361,15 @@ void BundleTracer::runUpdate(const UpdateFn& update, const TileFrame& f, uint32_
     glViewport(0, 0, scene_.pageResolution, scene_.pageResolution);
     const UpdatePrograms programs = update(f, nodeCount);
     glBindImageTexture(BINDING_HEADS, heads_.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
-    if (f.allLeaves) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_LEAF_TABLE, leafTable_.id());
+    if (f.leafRun) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, BINDING_LEAF_TABLE, leafTable_.id());
     // the two draws update disjoint texels (update.frag leaves curved ones to the second)
     for (GLuint program : {programs.triangles, programs.curved}) {
         if (!program) continue;
         glUseProgram(program);
         setFrameUniforms(program, f);
         glUniform1ui(glGetUniformLocation(program, "nodeCount"), nodeCount);
-        if (f.allLeaves) glUniform1i(glGetUniformLocation(program, "leafCount"), int(leafRecords_.size()));
+        if (f.leafRun)
+            glUniform1i(glGetUniformLocation(program, "leafCount"), int(groups_[size_t(activeGroup_)].records.size()));
         if (program == programs.triangles)
             drawClusters(program, clusters, true);
         else

@@ -5,14 +5,14 @@
 // update pass (the caller's program) that draws the tile's receiving
 // clusters in light map space.
 //
-// When all of a direction's tiles are whole leaves and their lists fit the
-// buffers together (the predictions, and the leaves' grids side by side in
-// one head image), and the caller has programs for it, the tiles are drawn
-// one after another into the same buffers and one update over all leaves
-// follows the last (update.frag LEAF_TABLE): each texel is drawn once a
-// direction instead of once for each tile its cluster meets. A draw that
-// overflows there starts the direction again tile by tile. Either way each
-// texel takes the same sample: the same bits.
+// Runs of consecutive tiles that are whole leaves (the budget did not cut
+// them) and whose lists fit the buffers together (the predictions, and the
+// leaves' grids side by side in one head image) are drawn one after another
+// into the same buffers, and one update over all their leaves follows the
+// run's last tile (update.frag LEAF_TABLE), when the caller has programs for
+// it: each texel is drawn once a run instead of once for each tile its
+// cluster meets. A draw that overflows there draws the run's tiles again
+// each alone. Either way each texel takes the same sample: the same bits.
 //
 // Memory: the node buffer and the head image start small and grow to what
 // the tiles predict (a quarter of margin), never past the budget's limits.
@@ -49,7 +49,7 @@ struct TileFrame {
     TileWindow drawn;   // and the pixels it draws: with a one-pixel apron (tiler.h drawnWindow)
     glm::ivec2 headOrigin{0};  // where the drawn window's first pixel lies in the head image
     float pixelSize = 1.0f;
-    bool allLeaves = false;  // the update over all of the direction's leaves (leaf, window: unused)
+    bool leafRun = false;  // the update over a run of whole leaves at once (leaf, window: unused)
 };
 
 // Sets the bundle_frame.glsl uniforms of `program` (bound).
@@ -93,7 +93,7 @@ public:
     };
     // Sets the update programs' uniforms (other than the frame's, the node
     // count and pageResolution, which the tracer sets) and returns them: for
-    // frame.allLeaves, the programs built with LEAF_TABLE.
+    // frame.leafRun, the programs built with LEAF_TABLE.
     using UpdateFn = std::function<UpdatePrograms(const TileFrame&, uint32_t nodeCount)>;
 
     // Curved texels (bake/curved_footprints.h) for the updates: per cluster,
@@ -111,16 +111,16 @@ public:
 
     // Tiles a direction: the clusters projected along frame.dir, the leaves
     // and tiles of tileBundle. recordStats: the direction counts in BakeStats
-    // (bakes; not the sun or captures). allLeaves: the update may be one over
-    // all leaves (the update function has LEAF_TABLE programs).
+    // (bakes; not the sun or captures). leafRuns: runs of whole leaves may be
+    // updated at once (the update function has LEAF_TABLE programs).
     void begin(const BundleFrame& frame, const TilerOptions& options, uint32_t seed, bool recordStats,
-               bool allLeaves = false);
+               bool leafRuns = false);
     bool done() const { return work_.empty(); }
     // Draws the next tile (one bundle draw) and, if it fit, its update.
     void next(const UpdateFn& update);
     // All of a direction's tiles.
     void run(const BundleFrame& frame, const TilerOptions& options, uint32_t seed, bool recordStats,
-             const UpdateFn& update, bool allLeaves = false);
+             const UpdateFn& update, bool leafRuns = false);
 
     // The latest direction's tiling (viewer overlays) and the latest tile's
     // lists (captures: head image row stride headSide()).
@@ -138,7 +138,7 @@ private:
     void ensureHeads(int side);
     void drawClusters(GLuint program, const std::vector<uint32_t>& ids, bool receiversOnly);
     void drawCurvedTexels(GLuint program, const std::vector<uint32_t>& ids);
-    bool planAllLeaves();  // whether the direction's update can be one over all leaves (and where they go)
+    void planGroups();  // which of the direction's tiles are updated at once (and where their lists go)
     void drawBundle(const Tile& tile, const TileFrame& f, bool resetCounter);
     void runUpdate(const UpdateFn& update, const TileFrame& f, uint32_t nodeCount, const std::vector<uint32_t>& clusters);
 
@@ -166,11 +166,19 @@ private:
     bool recordStats_ = false;
     int tiles_ = 0;
     uint32_t lastCount_ = 0;
-    // one update over all leaves (planAllLeaves): each tile's place in the head
-    // image, the leaf table, what the tiles drawn so far hold, and their counts
-    bool allLeaves_ = false;
-    std::vector<glm::ivec2> headOrigins_;
-    std::vector<shared::LeafRecord> leafRecords_;
+    // Runs of whole leaves updated at once (planGroups): each leaf's run (-1:
+    // alone) and place in the head image; per run its leaf table, nodes and
+    // image side; the run being drawn: its tiles, clusters and counts so far.
+    struct Group {
+        std::vector<shared::LeafRecord> records;
+        int64_t nodes = 0;
+        int side = 0;
+    };
+    std::vector<int> leafGroup_;
+    std::vector<glm::ivec2> leafOrigin_;
+    std::vector<Group> groups_;
+    int activeGroup_ = 0;
+    std::vector<Tile> groupTiles_;
     gl::Buffer leafTable_;
     std::vector<uint32_t> drawnClusters_;
     uint32_t drawnNodes_ = 0, drawnOwned_ = 0;

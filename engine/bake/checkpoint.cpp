@@ -47,7 +47,7 @@ uint64_t checkpointKey(const Baker::Impl& m) {
 // The counters stats.json reports, carried over a resume.
 nlohmann::json statsCounters(const BakeStats& s) {
     return {{"tiles_drawn", s.tilesDrawn}, {"overflows", s.overflows}, {"fragments", s.fragments},
-            {"all_leaves_updates", s.allLeavesUpdates},
+            {"leaf_run_updates", s.leafRunUpdates},
             {"updated_texels", s.updatedTexels}, {"peak_nodes_per_tile", s.peakNodesPerTile},
             {"bundle_triangles_drawn", s.bundleTrianglesDrawn}, {"update_triangles_drawn", s.updateTrianglesDrawn},
             {"seconds", {s.secondsTiling, s.secondsBundle, s.secondsUpdate, s.secondsResolve}},
@@ -61,7 +61,7 @@ bool restoreStatsCounters(const nlohmann::json& j, BakeStats& s) {
     try {
         s.tilesDrawn = j.at("tiles_drawn");
         s.overflows = j.at("overflows");
-        s.allLeavesUpdates = j.value("all_leaves_updates", int64_t(0));
+        s.leafRunUpdates = j.value("leaf_run_updates", int64_t(0));
         s.fragments = j.at("fragments");
         s.updatedTexels = j.at("updated_texels");
         s.peakNodesPerTile = j.at("peak_nodes_per_tile");

@@ -101,8 +101,8 @@ void Baker::Impl::bakeSun() {
         const glm::vec3 irradiance = lights[li].irradiance / radianceUnit;
         uint32_t footprintSample = 0;  // the jitter's index: each one samples another point of every texel's footprint
         const BundleTracer::UpdateFn update = [&](const TileFrame& f, uint32_t) {
-            const gl::Program& triangles = f.allLeaves ? sunAllLeavesProgram : sunProgram;
-            const gl::Program& curved = f.allLeaves ? sunCurvedAllLeavesProgram : sunCurvedProgram;
+            const gl::Program& triangles = f.leafRun ? sunLeafRunProgram : sunProgram;
+            const gl::Program& curved = f.leafRun ? sunCurvedLeafRunProgram : sunCurvedProgram;
             for (const gl::Program* program : {&triangles, &curved}) {
                 glUseProgram(program->id());
                 glUniform3fv(program->uniform("sunIrradiance"), 1, &irradiance.x);
@@ -119,7 +119,7 @@ void Baker::Impl::bakeSun() {
                 const glm::vec2 jitter((jx + 0.5f) / j - 0.5f, (jy + 0.5f) / j - 0.5f);
                 footprintSample = uint32_t(jy * j + jx);
                 tracer->run(bundleFrame(glm::normalize(lights[li].direction), jitter, sunOptions.uniform, jitterUnit),
-                            sunOptions, uint32_t(li * 1000 + jy * j + jx), false, update, true);
+                            sunOptions, uint32_t(li * 1000 + jy * j + jx), false, update, options.leafRuns);
             }
         foldDirect(true);  // this sun's mean over its valid samples, added to the direct map
     }

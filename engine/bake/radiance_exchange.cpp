@@ -34,8 +34,8 @@ void Baker::Impl::beginDirection(int k) {
     directionUpdate = [this, sampleWeight, seed, k](const TileFrame& f, uint32_t) {
         const bool useEnv = bool(envTexture);
         const glm::vec3 sky = options.sky / radianceUnit;
-        const gl::Program& triangles = f.allLeaves ? updateAllLeavesProgram : updateProgram;
-        const gl::Program& curved = f.allLeaves ? updateCurvedAllLeavesProgram : updateCurvedProgram;
+        const gl::Program& triangles = f.leafRun ? updateLeafRunProgram : updateProgram;
+        const gl::Program& curved = f.leafRun ? updateCurvedLeafRunProgram : updateCurvedProgram;
         for (const gl::Program* program : {&triangles, &curved}) {
             glUseProgram(program->id());
             glUniform1f(program->uniform("sampleWeight"), float(sampleWeight));
@@ -62,7 +62,7 @@ void Baker::Impl::beginDirection(int k) {
     // the light map's texels, the pattern moves from direction to direction and
     // averages out instead of settling into stripes (issue 11)
     const glm::vec2 phase(uniform01(pcgHash(seed ^ 0x5bd1e995u)) - 0.5f, uniform01(pcgHash(seed ^ 0x1b873593u)) - 0.5f);
-    tracer->begin(bundleFrame(d, phase, tilerOptions.uniform, pixelSize), tilerOptions, seed, true, true);
+    tracer->begin(bundleFrame(d, phase, tilerOptions.uniform, pixelSize), tilerOptions, seed, true, options.leafRuns);
     directionActive = true;
 }
 

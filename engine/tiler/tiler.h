@@ -155,7 +155,7 @@ Tile makeTile(const DirectionTiling& tiling, int leaf, const TileWindow& window,
 // image of side `side` (a power of two, the least that holds them, at most
 // maxSide): shelves of the largest first, in a fixed order. Returns their
 // lower-left corners, or nothing when they do not fit in maxSide^2. Used to
-// hold all of a direction's leaves' head pointers at once (bundle_tracer.h).
+// hold a run of a direction's leaves' head pointers at once (bundle_tracer.h).
 std::vector<glm::ivec2> packSquares(const std::vector<int>& sides, int maxSide, int& side);
 
 // The four quarters of a window (fewer when it is one pixel wide or high).

@@ -14,7 +14,7 @@ uniform vec3 bundleV;
 uniform vec2 rootOrigin;     // (u, v) of the root square's lower-left corner, scene units
 uniform float rootSize;      // the root square's side, scene units
 // The leaf's and the tile's parameters: uniforms, or (LEAF_TABLE: one update
-// over all of a direction's leaves, lightmap/update.frag) set per fragment
+// over a run of leaves, lightmap/update.frag) set per fragment
 // from the leaf that holds its texel.
 #ifdef LEAF_TABLE
 #define LEAF_PARAM

@@ -78,7 +78,7 @@ layout(binding = BINDING_FOOTPRINT) uniform usampler2DArray footprint;
 const float PI = 3.14159265358979;
 
 #ifdef LEAF_TABLE
-// One update over all of a direction's leaves (engine/bake/bundle_tracer.h):
+// One update over a run of whole leaves (engine/bake/bundle_tracer.h):
 // each leaf's lists at its place in one head image, the leaves in a table.
 layout(std430, binding = BINDING_LEAF_TABLE) readonly buffer Leaves { LeafRecord leafTable[]; };
 uniform int leafCount;

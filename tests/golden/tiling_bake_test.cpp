@@ -134,35 +134,43 @@ TEST(TilingBake, SteppingByTileGivesTheSameBits) {
     EXPECT_EQ(differingTexels(whole, tiled), 0u);
 }
 
-// Where a direction's tiles are whole leaves and their lists fit the buffers
-// together, one update pass over all the leaves follows the last tile
-// (bundle_tracer.h): each texel is drawn once a direction instead of once for
-// each tile its cluster meets. mixed_lighting's curved furniture cuts its
-// directions into ~20 leaves. With a head image too small to hold them side
-// by side the update goes tile by tile: the same bits, more triangles drawn.
-TEST(TilingBake, OneUpdateOverAllLeavesGivesTheSameBits) {
+// Runs of whole leaves whose lists fit the buffers together are updated in
+// one pass (bundle_tracer.h): each texel is drawn once a run instead of once
+// for each tile its cluster meets. mixed_lighting's curved furniture cuts its
+// directions into ~20 leaves. Roomy buffers hold a direction in one run; a
+// head image of 128^2 cuts it into several; with runs off every tile is
+// updated alone. The same bits every way, fewer triangles drawn.
+TEST(TilingBake, LeafRunsUpdatedAtOnceGiveTheSameBits) {
     BB_REQUIRE_GL();
     const std::string scene = sourcePath("assets/shared/mixed_lighting/MixedLightingExample.gltf");
     BakeOptions o = skyOptions(6, 2);
     o.supersample = 2;  // as the CLI's auto: the texels the curvature refinement cuts the leaves for
-    const Baked together = bakeCity(scene, o, packLayout(64));
-    ASSERT_TRUE(together.error.empty()) << together.error;
+    const Baked roomy = bakeCity(scene, o, packLayout(64));
+    ASSERT_TRUE(roomy.error.empty()) << roomy.error;
     o.bundleMemory = (int64_t(1) << 20) - 1;  // a head image of 128^2 (a quarter of it at most), 81919 nodes
-    const Baked apart = bakeCity(scene, o, packLayout(64));
-    ASSERT_TRUE(apart.error.empty()) << apart.error;
-    std::printf("[tiling] mixed_lighting: %.1f leaves a direction; %lld of %d directions updated at once, update "
-                "triangles drawn %lld (at once) / %lld (tile by tile), tiles %lld / %lld, nodes at most %lld / %lld\n",
-                double(std::accumulate(together.stats.leavesPerDirection.begin(), together.stats.leavesPerDirection.end(), 0)) /
-                    double(std::max<size_t>(together.stats.leavesPerDirection.size(), 1)),
-                (long long)together.stats.allLeavesUpdates, together.stats.directionsDone,
-                (long long)together.stats.updateTrianglesDrawn, (long long)apart.stats.updateTrianglesDrawn,
-                (long long)together.stats.tilesDrawn, (long long)apart.stats.tilesDrawn,
-                (long long)together.stats.peakNodesPerTile, (long long)apart.stats.peakNodesPerTile);
-    EXPECT_GT(together.stats.allLeavesUpdates, 0);
-    EXPECT_EQ(apart.stats.allLeavesUpdates, 0);
-    EXPECT_LT(2 * together.stats.updateTrianglesDrawn, apart.stats.updateTrianglesDrawn);
-    EXPECT_EQ(together.stats.fragments, apart.stats.fragments);
-    EXPECT_EQ(differingTexels(together, apart), 0u);
+    const Baked small = bakeCity(scene, o, packLayout(64));
+    ASSERT_TRUE(small.error.empty()) << small.error;
+    o.bundleMemory = 0;
+    o.leafRuns = false;
+    const Baked alone = bakeCity(scene, o, packLayout(64));
+    ASSERT_TRUE(alone.error.empty()) << alone.error;
+    const auto& leaves = roomy.stats.leavesPerDirection;
+    std::printf("[tiling] mixed_lighting, %d directions, %.1f leaves a direction: updates over leaf runs %lld / %lld "
+                "/ %lld, update triangles drawn %lld / %lld / %lld (roomy / 128^2 heads / runs off)\n",
+                roomy.stats.directionsDone,
+                double(std::accumulate(leaves.begin(), leaves.end(), 0)) / double(std::max<size_t>(leaves.size(), 1)),
+                (long long)roomy.stats.leafRunUpdates, (long long)small.stats.leafRunUpdates,
+                (long long)alone.stats.leafRunUpdates, (long long)roomy.stats.updateTrianglesDrawn,
+                (long long)small.stats.updateTrianglesDrawn, (long long)alone.stats.updateTrianglesDrawn);
+    EXPECT_EQ(roomy.stats.leafRunUpdates, roomy.stats.directionsDone);  // one run a direction
+    EXPECT_GT(small.stats.leafRunUpdates, roomy.stats.leafRunUpdates);
+    EXPECT_EQ(alone.stats.leafRunUpdates, 0);
+    EXPECT_LT(2 * roomy.stats.updateTrianglesDrawn, alone.stats.updateTrianglesDrawn);
+    EXPECT_LT(small.stats.updateTrianglesDrawn, alone.stats.updateTrianglesDrawn);
+    EXPECT_EQ(roomy.stats.fragments, alone.stats.fragments);
+    EXPECT_EQ(small.stats.fragments, alone.stats.fragments);
+    EXPECT_EQ(differingTexels(roomy, alone), 0u);
+    EXPECT_EQ(differingTexels(small, alone), 0u);
 }
 
 // The projected-area prediction per tile on three generated sizes, cut into
