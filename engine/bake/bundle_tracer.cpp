@@ -117,6 +117,11 @@ void drawCurvedTexelRuns(GLuint program, int res, const std::vector<int32_t>& fi
         }
 }
 
+// At most this many leaves a run: each update fragment looks its leaf up in
+// the run's table (update.frag takeLeaf), and each tile added to a run packs
+// the run's leaves again.
+constexpr size_t kMostLeavesInARun = 64;
+
 void BundleTracer::planGroups() {
     const std::vector<Tile>& tiles = tiling_.tiles;
     leafGroup_.assign(tiling_.leaves.size(), -1);
@@ -162,7 +167,7 @@ void BundleTracer::planGroups() {
             sides.push_back(pixels);
             std::vector<glm::ivec2> placed;
             int placedSide = 0;
-            if (nodesFor(predicted + t.predictedNodes) <= limits_.nodeCapacity)
+            if (sides.size() <= kMostLeavesInARun && nodesFor(predicted + t.predictedNodes) <= limits_.nodeCapacity)
                 placed = packSquares(sides, limits_.maxTileSize, placedSide);
             if (!placed.empty()) {
                 origins = std::move(placed);
