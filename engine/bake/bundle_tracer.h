@@ -13,8 +13,8 @@
 // it: each texel is drawn once a run instead of once for each tile its
 // cluster meets. A draw that overflows there draws the run's tiles again
 // each alone. Either way each texel takes the same sample: the same bits
-// (but where a texel takes two samples in one direction, whose fold order
-// follows the draws: design notes "One update over a run of leaves").
+// (but for a few fragments the rasterizer draws differently at a leaf's
+// place in the head image: design notes "One update over a run of leaves").
 //
 // Memory: the node buffer and the head image start small and grow to what
 // the tiles predict (a quarter of margin), never past the budget's limits.
