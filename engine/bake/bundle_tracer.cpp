@@ -124,9 +124,6 @@ constexpr size_t kMostLeavesInARun = 64;
 
 void BundleTracer::planGroups() {
     const std::vector<Tile>& tiles = tiling_.tiles;
-    leafGroup_.assign(tiling_.leaves.size(), -1);
-    leafOrigin_.assign(tiling_.leaves.size(), glm::ivec2(0));
-    groups_.clear();
     const auto nodesFor = [](double predicted) { return int64_t(std::ceil(1.25 * predicted)) + 1024; };
     // the open run: tiles [first, i), their predicted nodes, their leaves' sides and places
     size_t first = 0;
@@ -194,15 +191,11 @@ void BundleTracer::begin(const BundleFrame& frame, const TilerOptions& options, 
     tiling_ = tileBundle(*scene_.clusters, views_, frame.size, options);
     work_.assign(tiling_.tiles.rbegin(), tiling_.tiles.rend());
     tiles_ = 0;
-    drawnTiles_.clear();
-    drawnClusters_.clear();
-    groupTiles_.clear();
-    if (leafRuns) {
-        planGroups();
-    } else {
-        leafGroup_.assign(tiling_.leaves.size(), -1);
-        groups_.clear();
-    }
+    clearRun();
+    leafGroup_.assign(tiling_.leaves.size(), -1);
+    leafOrigin_.assign(tiling_.leaves.size(), glm::ivec2(0));
+    groups_.clear();
+    if (leafRuns) planGroups();
     if (recordStats) {
         stats_->secondsTiling += secondsSince(t0);
         stats_->leavesPerDirection.push_back(int(tiling_.leaves.size()));
@@ -277,9 +270,7 @@ void BundleTracer::next(const UpdateFn& update) {
             std::replace(leafGroup_.begin(), leafGroup_.end(), group, -1);
             work_.push_back(std::move(tile));
             for (auto it = groupTiles_.rbegin(); it != groupTiles_.rend(); ++it) work_.push_back(std::move(*it));
-            groupTiles_.clear();
-            drawnTiles_.clear();
-            drawnClusters_.clear();
+            clearRun();
             return;
         }
         // Redraw into a buffer of the measured size if the budget holds it, else in four quarters.
@@ -299,13 +290,9 @@ void BundleTracer::next(const UpdateFn& update) {
     drawnNodes_ = count;
     drawnOwned_ = counts[1];
     if (group >= 0) {
-        drawnClusters_.insert(drawnClusters_.end(), tile.clusters.begin(), tile.clusters.end());
         groupTiles_.push_back(std::move(tile));
         if (groupTiles_.size() < groups_[size_t(group)].records.size()) return;  // the update follows the run's last tile
-        std::sort(drawnClusters_.begin(), drawnClusters_.end());
-        drawnClusters_.erase(std::unique(drawnClusters_.begin(), drawnClusters_.end()), drawnClusters_.end());
         f.leafRun = true;
-        activeGroup_ = group;
     }
     if (recordStats_) {
         for (const DrawnTile& t : drawnTiles_) {
@@ -316,10 +303,18 @@ void BundleTracer::next(const UpdateFn& update) {
         stats_->peakNodesPerTile = std::max<int64_t>(stats_->peakNodesPerTile, count);  // what the buffer held
         stats_->leafRunUpdates += f.leafRun;
     }
-    drawnTiles_.clear();
-    if (count > 0) runUpdate(update, f, count, f.leafRun ? drawnClusters_ : tile.clusters);
-    drawnClusters_.clear();
-    groupTiles_.clear();
+    if (count > 0) {
+        if (f.leafRun) {  // the run's receivers, each cluster once
+            std::vector<uint32_t> clusters;
+            for (const Tile& t : groupTiles_) clusters.insert(clusters.end(), t.clusters.begin(), t.clusters.end());
+            std::sort(clusters.begin(), clusters.end());
+            clusters.erase(std::unique(clusters.begin(), clusters.end()), clusters.end());
+            runUpdate(update, f, count, clusters);
+        } else {
+            runUpdate(update, f, count, tile.clusters);
+        }
+    }
+    clearRun();
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     if (recordStats_ && work_.empty()) stats_->tilesPerDirection.push_back(tiles_);
 }
@@ -374,7 +369,7 @@ void BundleTracer::runUpdate(const UpdateFn& update, const TileFrame& f, uint32_
         setFrameUniforms(program, f);
         glUniform1ui(glGetUniformLocation(program, "nodeCount"), nodeCount);
         if (f.leafRun)
-            glUniform1i(glGetUniformLocation(program, "leafCount"), int(groups_[size_t(activeGroup_)].records.size()));
+            glUniform1i(glGetUniformLocation(program, "leafCount"), int(groupTiles_.size()));  // the run's leaves
         if (program == programs.triangles)
             drawClusters(program, clusters, true);
         else

@@ -140,7 +140,11 @@ private:
     void ensureHeads(int side);
     void drawClusters(GLuint program, const std::vector<uint32_t>& ids, bool receiversOnly);
     void drawCurvedTexels(GLuint program, const std::vector<uint32_t>& ids);
-    void planGroups();  // which of the direction's tiles are updated at once (and where their lists go)
+    void clearRun() {  // the run being drawn: none
+        groupTiles_.clear();
+        drawnTiles_.clear();
+    }
+    void planGroups();  // which of the direction's tiles are updated at once (and where their lists go); after a reset
     void drawBundle(const Tile& tile, const TileFrame& f, bool resetCounter);
     void runUpdate(const UpdateFn& update, const TileFrame& f, uint32_t nodeCount, const std::vector<uint32_t>& clusters);
 
@@ -170,7 +174,7 @@ private:
     uint32_t lastCount_ = 0;
     // Runs of whole leaves updated at once (planGroups): each leaf's run (-1:
     // alone) and place in the head image; per run its leaf table, nodes and
-    // image side; the run being drawn: its tiles, clusters and counts so far.
+    // image side; the run being drawn: its tiles and counts so far.
     struct Group {
         std::vector<shared::LeafRecord> records;
         int64_t nodes = 0;
@@ -179,10 +183,8 @@ private:
     std::vector<int> leafGroup_;
     std::vector<glm::ivec2> leafOrigin_;
     std::vector<Group> groups_;
-    int activeGroup_ = 0;
     std::vector<Tile> groupTiles_;
     gl::Buffer leafTable_;
-    std::vector<uint32_t> drawnClusters_;
     uint32_t drawnNodes_ = 0, drawnOwned_ = 0;
     struct DrawnTile {
         double predicted;

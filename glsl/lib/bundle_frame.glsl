@@ -25,7 +25,7 @@ LEAF_PARAM vec2 leafMin;        // the leaf's lower-left corner, root units
 LEAF_PARAM float leafExtent;    // the leaf's side, root units
 LEAF_PARAM int leafPixels;      // pixels across the leaf
 LEAF_PARAM float pixelSize;     // scene units per pixel of this leaf
-LEAF_PARAM ivec2 tileOffset;    // the leaf grid's pixel at the head image's origin (the drawn window's first, or minus the leaf's place in an atlas)
+LEAF_PARAM ivec2 tileOffset;    // head image pixel p is the leaf grid's pixel p + tileOffset
 LEAF_PARAM ivec4 drawnPixels;   // the pixels the tile draws in the head image: [xy, zw) (its own and a one-pixel apron within the leaf)
 LEAF_PARAM ivec4 ownedPixels;   // the tile's own pixels in the head image: [xy, zw)
 
@@ -37,6 +37,9 @@ vec3 bundleFromWorld(vec3 p) { return vec3(dot(p, bundleU), dot(p, bundleV), dot
 
 // Root units: [0, 1]^2 spans the root square.
 vec2 rootFromBundle(vec2 uv) { return (uv - rootOrigin) / rootSize; }
-bool leafOwns(vec2 q) { return all(greaterThanEqual(q, leafMin)) && all(lessThan(q, leafMin + vec2(leafExtent))); }
+// Whether q lies in the square [lo, lo + extent)^2 (root units): the one test
+// of a leaf's bounds, for a tile's uniforms and a run's table alike.
+bool inSquare(vec2 q, vec2 lo, float extent) { return all(greaterThanEqual(q, lo)) && all(lessThan(q, lo + vec2(extent))); }
+bool leafOwns(vec2 q) { return inSquare(q, leafMin, leafExtent); }
 // Position in the leaf's pixels (continuous).
 vec2 gridFromRoot(vec2 q) { return (q - leafMin) * (float(leafPixels) / leafExtent); }

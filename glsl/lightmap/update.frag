@@ -90,7 +90,7 @@ bool takeLeaf(vec2 q) {
     for (int i = 0; i < leafCount; ++i) {
         LeafRecord l = leafTable[i];
         vec2 lo = vec2(l.minX, l.minY);
-        if (all(greaterThanEqual(q, lo)) && all(lessThan(q, lo + vec2(l.extent)))) {
+        if (inSquare(q, lo, l.extent)) {
             leafMin = lo;
             leafExtent = l.extent;
             leafPixels = l.pixels;

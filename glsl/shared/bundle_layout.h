@@ -16,8 +16,8 @@ struct Node {
     uint next;      // index of the next node in this pixel's list, or END_OF_LIST
 };
 
-// One leaf of a direction, for one update over all its leaves
-// (BINDING_LEAF_TABLE; lightmap/update.frag takeLeaf): 32 bytes.
+// One leaf of a run updated at once (BINDING_LEAF_TABLE; lightmap/update.frag
+// takeLeaf, engine/bake/bundle_tracer.h): 32 bytes.
 struct LeafRecord {
     float minX, minY;  // the leaf's lower-left corner, root units
     float extent;      // its side, root units
@@ -45,7 +45,7 @@ struct LeafRecord {
 #define BINDING_CURVED_TEXELS 3  // SSBO: curved texels (lib/curved_footprint.glsl), update and sun passes
 #define BINDING_CURVED_REFS 4    // SSBO: their triangles' indices
 #define BINDING_CURVED_TRIANGLES 7  // SSBO: CurvedTriangle curvedTriangles[]
-#define BINDING_LEAF_TABLE 8     // SSBO: a direction's leaves for one update over all of them (LeafRecord, update.frag)
+#define BINDING_LEAF_TABLE 8     // SSBO: a run's leaves for one update over all of them (LeafRecord, update.frag)
 #define BINDING_HEADS 0          // image unit: r32ui head pointers of the tile
 #define BINDING_ACCUM 1          // image unit: rg32ui accumulators (packed fp16 RGB + W), array of pages
 #define BINDING_DIRECT 2         // image unit: rgba16f direct light L_lm (sun + emitters); a: the sun's sample count while it is baked

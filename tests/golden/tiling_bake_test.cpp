@@ -27,7 +27,7 @@ struct Baked {
     std::string error;
 };
 
-Baked bakeCity(const std::string& path, const BakeOptions& options, const LayoutOptions& layout = cityLayout()) {
+Baked bakeScene(const std::string& path, const BakeOptions& options, const LayoutOptions& layout = cityLayout()) {
     Baked out;
     SceneBake bake = makeBake(path, layout, options);
     if (!bake) {
@@ -56,14 +56,14 @@ TEST(TilingBake, TinyBudgetGivesTheSameBits) {
     BB_REQUIRE_GL();
     const std::string city = generateTinyCity("budget", "--seed 5");
     ASSERT_FALSE(city.empty()) << "scripts/generate_city.py failed";
-    const Baked roomy = bakeCity(city, cityOptions());
+    const Baked roomy = bakeScene(city, cityOptions());
     ASSERT_TRUE(roomy.error.empty()) << roomy.error;
     BakeOptions tightOptions = cityOptions();
     tightOptions.bundleMemory = 64 * 64 * 4 + 3000 * 12;
-    const Baked tight = bakeCity(city, tightOptions);
+    const Baked tight = bakeScene(city, tightOptions);
     ASSERT_TRUE(tight.error.empty()) << tight.error;
     tightOptions.predictTiles = false;
-    const Baked splitOnly = bakeCity(city, tightOptions);
+    const Baked splitOnly = bakeScene(city, tightOptions);
     ASSERT_TRUE(splitOnly.error.empty()) << splitOnly.error;
 
     std::printf("[tiling] tiles drawn %lld (roomy), %lld (tight, %lld overflows), %lld (overflow splits only, %lld "
@@ -90,10 +90,10 @@ TEST(TilingBake, CullingChangesNothing) {
     ASSERT_FALSE(city.empty()) << "scripts/generate_city.py failed";
     BakeOptions o = cityOptions();
     o.bundleMemory = 1 << 20;  // several tiles per direction, so there is something to cull
-    const Baked on = bakeCity(city, o);
+    const Baked on = bakeScene(city, o);
     ASSERT_TRUE(on.error.empty()) << on.error;
     o.cull = false;
-    const Baked off = bakeCity(city, o);
+    const Baked off = bakeScene(city, o);
     ASSERT_TRUE(off.error.empty()) << off.error;
     std::printf("[tiling] culling: %lld tiles; bundle pass drew %lld triangles with culling, %lld without\n",
                 (long long)on.stats.tilesDrawn, (long long)on.stats.bundleTrianglesDrawn,
@@ -113,7 +113,7 @@ TEST(TilingBake, SteppingByTileGivesTheSameBits) {
     ASSERT_FALSE(city.empty()) << "scripts/generate_city.py failed";
     BakeOptions o = cityOptions();
     o.bundleMemory = 1 << 20;
-    const Baked whole = bakeCity(city, o);
+    const Baked whole = bakeScene(city, o);
     ASSERT_TRUE(whole.error.empty()) << whole.error;
 
     SceneBake bake = makeBake(city, cityLayout(), o);
@@ -145,14 +145,14 @@ TEST(TilingBake, LeafRunsUpdatedAtOnceGiveTheSameBits) {
     const std::string scene = sourcePath("assets/shared/mixed_lighting/MixedLightingExample.gltf");
     BakeOptions o = skyOptions(6, 2);
     o.supersample = 2;  // as the CLI's auto: the texels the curvature refinement cuts the leaves for
-    const Baked roomy = bakeCity(scene, o, packLayout(64));
+    const Baked roomy = bakeScene(scene, o, packLayout(64));
     ASSERT_TRUE(roomy.error.empty()) << roomy.error;
     o.bundleMemory = (int64_t(1) << 20) - 1;  // a head image of 128^2 (a quarter of it at most), 81919 nodes
-    const Baked small = bakeCity(scene, o, packLayout(64));
+    const Baked small = bakeScene(scene, o, packLayout(64));
     ASSERT_TRUE(small.error.empty()) << small.error;
     o.bundleMemory = 0;
     o.leafRuns = false;
-    const Baked alone = bakeCity(scene, o, packLayout(64));
+    const Baked alone = bakeScene(scene, o, packLayout(64));
     ASSERT_TRUE(alone.error.empty()) << alone.error;
     const auto& leaves = roomy.stats.leavesPerDirection;
     std::printf("[tiling] mixed_lighting, %d directions, %.1f leaves a direction: updates over leaf runs %lld / %lld "
@@ -191,7 +191,7 @@ TEST(TilingBake, PredictionHoldsOnThreeSizes) {
         ASSERT_FALSE(city.empty()) << "scripts/generate_city.py failed for " << s.flags;
         BakeOptions o = cityOptions();
         o.bundleMemory = 1 << 20;
-        const Baked b = bakeCity(city, o);
+        const Baked b = bakeScene(city, o);
         ASSERT_TRUE(b.error.empty()) << b.error;
         std::vector<double> r = b.stats.predictedOverActual;
         ASSERT_GT(r.size(), 8u);

@@ -300,7 +300,7 @@ TEST(Tiler, CullingKeepsOnlyClustersThatMeetTheTile) {
     EXPECT_EQ(count[0], int32_t(3 * mesh.triangles.size()));
 }
 
-// A direction's leaves side by side in one head image (one update over all of
+// A run of leaves side by side in one head image (one update over all of
 // them, bundle_tracer.h): inside the image, no two overlapping, the image the
 // least power of two that holds them; nothing when the limit cannot.
 TEST(Tiler, PackedSquaresDoNotOverlapAndFitTheLeastPowerOfTwo) {
