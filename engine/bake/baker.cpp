@@ -94,7 +94,8 @@ nlohmann::json BakeStats::toJson() const {
     nlohmann::json j;
     j["directions"] = {{"done", directionsDone}, {"total", directionsTotal}};
     j["bundle"] = {{"resolution_pixels", bundleResolution}, {"pixel_size_scene_units", pixelSize},
-                   {"history_power", historyPower}, {"transport_albedo", transportAlbedo},
+                   {"history_power", historyPower}, {"history_plateau", historyPlateau},
+                   {"transport_albedo", transportAlbedo},
                    {"radiance_unit", radianceUnit}};
     auto pct = [&](double q) { return quantile(predictedOverActual, q); };
     auto size = [&](double q) { return quantile(tilePixelSizes, q); };
@@ -741,6 +742,8 @@ Status Baker::Impl::init(const Scene& scene) {
         for (const Cluster& c : clusters) imax = std::max(imax, c.maxImportance);
         if (imax > 0.0f) sunPixelSize = pixelForImportance(imax, tilerOptions.pixelsPerTexel);
     }
+    historyPlateau = chooseHistoryPlateau();  // the lag model needs the pixels a texel spans
+    stats.historyPlateau = historyPlateau;
     {
         // the bundle pass: its buffers start small and grow to what the tiles predict
         MemoryCategory category("bundles");

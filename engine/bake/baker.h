@@ -54,10 +54,14 @@ struct BakeOptions {
     glm::vec3 sky{0.0f};              // uniform sky radiance (scene units)
     std::optional<io::ImageRgb> environment;  // equirectangular environment radiance; replaces sky
     Rounding rounding = Rounding::Stochastic;
-    // History ramp: direction k is weighted min(k, directions/2)^power, so early
+    // History ramp: direction k is weighted min(k, plateau)^power, so early
     // directions (which saw light maps with few bounces) fade out. < 0 = from
     // the scene's transport albedo (defaultHistoryPower, bake/transport_albedo.h).
     float historyPower = -1.0f;
+    // The round from which the ramp's weights stay equal; <= 0: the earliest
+    // the bounce-lag model allows (noise.cpp chooseHistoryPlateau), at most
+    // half the rounds (where the ramp ended until 2026-12-05).
+    int historyPlateau = 0;
     // Cut each tile until its predicted node count (projected cluster areas /
     // pixel area) fits 80 % of the budget's node buffer, and size the buffer
     // from the predictions. false: the buffer is allocated at the budget and
@@ -108,6 +112,7 @@ struct BakeStats {
     double bundleResolution = 0;      // pixels across the bounding sphere (the uniform grid)
     double pixelSize = 0;             // scene units (the uniform grid's; tiles: tilePixelSizes)
     double historyPower = 0;
+    int historyPlateau = 0;           // rounds: the ramp's weights are equal from this one on
     double transportAlbedo = 0;       // the light's share kept per bounce (bake/transport_albedo.h)
     double radianceUnit = 1;          // the light-map state holds radiance / this (a power of two; fp16 range)
     int64_t tilesDrawn = 0;

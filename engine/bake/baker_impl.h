@@ -46,6 +46,7 @@ struct Baker::Impl {
     double historyPower = 0.0;
     double accumLogScale = 0.0;  // stored weights are true weights / exp(accumLogScale)
     int refreshEveryRound = 64;  // rounds refreshed after each one before the schedule thins out (bounces)
+    int historyPlateau = 1;      // the ramp's weights are equal from this round on (chooseHistoryPlateau)
     float radianceUnit = 1.0f;  // the light-map state holds radiance / radianceUnit (sanitizeInputs)
     std::vector<double> projectedArea;  // per triangle world area
     std::vector<Cluster> clusters;      // the mesh in culling units (engine/tiler)
@@ -179,10 +180,11 @@ struct Baker::Impl {
     int shareIndex() const { return options.share ? options.share->index() : 0; }
     int shareCount() const { return options.share ? options.share->count() : 1; }
     int rounds() const { return (options.directions + shareCount() - 1) / shareCount(); }
-    // ln of round j's weight in the history ramp, min(j+1, rounds/2)^historyPower (in logs: powers up to 256)
-    double rampLogWeight(int round) const {
-        return historyPower * std::log(std::min(double(round + 1), double(std::max(1, rounds() / 2))));
+    // ln of round j's weight in the history ramp, min(j+1, plateau)^historyPower (in logs: powers up to 1024)
+    double rampLogWeight(int round, int plateau) const {
+        return historyPower * std::log(std::min(double(round + 1), double(plateau)));
     }
+    double rampLogWeight(int round) const { return rampLogWeight(round, historyPlateau); }
     // Rounds between radiance refreshes after round j: 1 while bounces are
     // still needed (refreshEveryRound), then one more every 32 rounds, at most 8.
     int refreshInterval(int round) const {
@@ -205,10 +207,18 @@ struct Baker::Impl {
     void estimateNoise();
     double noiseHalvesFactor() const;  // noise.cpp
     double bounceLag();                // noise.cpp
-    struct LagModel {                  // bounceLag's state: rounds run, mean, weight, mean read
+    int chooseHistoryPlateau() const;  // noise.cpp
+    // bounceLag's model of one bounce mode over the bake's schedule: rounds
+    // run, the mean, its weight (relative to the last round's) and the mean read
+    struct LagModel {
         int rounds = 0;
         double mean = 0, weight = 0, read = 0;
+        // round `rounds` of the schedule: its ramp weight over the last one's
+        // (exp of their logs' difference), and whether a refresh follows it
+        void advance(double weightStep, bool refresh, double lambda, double missed);
+        double lag(double lambda) const { return std::max(0.0, 1.0 - mean * (1.0 - lambda)); }
     } lagModel;
+    double lagMissedShare() const;  // noise.cpp: the model's share of samples that weigh 0
     int directionsGoal() const { return stats.stoppedAtTargetNoise ? stats.directionsDone : options.directions; }
 };
 

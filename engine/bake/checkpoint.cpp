@@ -34,7 +34,8 @@ uint64_t checkpointKey(const Baker::Impl& m) {
     // not the memory budget: the bytes do not depend on it (tiling_bake_test), so a bake may resume with another
     const int64_t ints[] = {m.layout.resolution, m.layout.pageCount, o.directions, o.bundleResolution,
                             int64_t(o.tiling), int64_t(o.seed), int64_t(o.rounding), o.sunJitter,
-                            o.environment ? 1 : 0, int64_t(o.directLight), o.emitterSamples, o.emitterShadowSize};
+                            o.environment ? 1 : 0, int64_t(o.directLight), o.emitterSamples, o.emitterShadowSize,
+                            m.historyPlateau};
     h = fnv1a(ints, sizeof ints, h);
     const double reals[] = {o.sky.r, o.sky.g, o.sky.b, m.historyPower};
     h = fnv1a(reals, sizeof reals, h);

@@ -66,7 +66,11 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
         ->check(CLI::IsMember({"stochastic", "nearest"}))
         ->capture_default_str();
     cmd.add_option("--history-power", a.historyPower,
-                   "Weight direction k by min(k, N/2)^p to fade early, few-bounce directions (-1 = from the scene's transport albedo, the light's share kept per bounce)")
+                   "Weight direction k by min(k, plateau)^p to fade early, few-bounce directions (-1 = from the scene's transport albedo, the light's share kept per bounce)")
+        ->capture_default_str();
+    cmd.add_option("--history-plateau", a.historyPlateau,
+                   "The direction from which every one weighs the same (0 = the earliest that leaves under 1e-4 of the bounced light to come, at most N/2)")
+        ->check(CLI::NonNegativeNumber)
         ->capture_default_str();
     cmd.add_option("--direct", a.direct,
                    "Direct light from emissive triangles: explicit (form factor x shadow cube maps), bundles, or auto "
@@ -153,6 +157,7 @@ int runBake(const BakeArgs& args) {
     options.sky = *sky;
     options.rounding = args.rounding == "nearest" ? Rounding::Nearest : Rounding::Stochastic;
     options.historyPower = args.historyPower;
+    options.historyPlateau = args.historyPlateau;
     options.directLight = args.direct == "explicit" ? BakeOptions::DirectLight::Explicit
                         : args.direct == "bundles"  ? BakeOptions::DirectLight::Bundles
                                                     : BakeOptions::DirectLight::Auto;
@@ -228,6 +233,7 @@ int runBake(const BakeArgs& args) {
                      {"seed", args.seed}, {"sky", args.sky}, {"env", args.env}, {"rounding", args.rounding},
                      {"uv_layout", args.scene.uvLayout}, {"resolution", args.scene.resolution},
                      {"texel_density", args.scene.texelDensity}, {"history_power", (*baker)->stats().historyPower},
+                     {"history_plateau", (*baker)->stats().historyPlateau},
                      {"direct", args.direct}, {"emitter_samples", args.emitterSamples},
                      {"seams", args.seams}, {"supersample", args.supersample}, {"mpi_ranks", mpi ? mpi->count() : 1}, {"target_noise", args.targetNoise}};
     info.wallSeconds = seconds;

@@ -47,6 +47,7 @@ struct BakeArgs {
     double targetNoise = 0;           // > 0: stop at this estimated relative noise
     std::string rounding = "stochastic";
     float historyPower = -1.0f;
+    int historyPlateau = 0;
     std::string direct = "auto";
     int emitterSamples = 0;
     std::string supersample = "auto";  // auto | 1 | 2 | 4 (BakeOptions::supersample)

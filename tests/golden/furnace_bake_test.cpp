@@ -63,7 +63,7 @@ void runFurnace(const FurnaceCase& fc) {
     ASSERT_EQ(maps.pages.size(), 1u);
     Summary s = summarizeCovered(maps);
     const double expectation =
-        furnaceExpectation(1.0, fc.rho, fc.directions, defaultHistoryPower(fc.rho));
+        furnaceExpectation(1.0, fc.rho, fc.directions, defaultHistoryPower(fc.rho), bake.baker->stats().historyPlateau);
     std::printf("[furnace] %s, %d directions, %.2f s: %s (answer %.4f, iteration expectation %.4f)\n", fc.file,
                 fc.directions, seconds, describe(s, 64).c_str(), answer, expectation);
 

@@ -65,7 +65,7 @@ TEST(RoundingBake, NearestDivergesPastW2048StochasticTracksExpectation) {
     BB_REQUIRE_GL();
     const int directions = 8192;
     const double storedRho = halfToFloat(floatToHalf(0.9f, Rounding::Nearest, 0.0f));
-    const double expected = furnaceExpectation(1.0, storedRho, directions, 0.0);
+    const double expected = furnaceExpectation(1.0, storedRho, directions, 0.0, 1);  // power 0: every direction weighs 1
     std::string error;
     LongBake stochastic = longFurnaceBake(Rounding::Stochastic, directions, &error);
     ASSERT_TRUE(error.empty()) << error;

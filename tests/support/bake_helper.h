@@ -195,14 +195,14 @@ inline bool radianceRefreshedAfter(int k, int directions, double rho) {
 
 // The expected furnace value after N directions with the baker's history
 // ramp (BakeOptions::historyPower; direction k, 1-based, weighs
-// min(k, N/2)^p): L_lm is the weighted mean of the incoming radiance seen by
+// min(k, plateau)^p, BakeStats::historyPlateau): L_lm is the weighted mean of the incoming radiance seen by
 // each direction, Le + rho * R, R the light map as last resolved into the
 // radiance map (radianceRefreshedAfter), so
 //   M_k = sum_j w_j (Le + rho R_j) / sum_j w_j,  R_j = M at the last refresh before j.
 // This is the bake's expectation in a furnace (every texel sees the same
 // value); its gap to Le / (1 - rho) is the start-up bias of the iteration.
-inline double furnaceExpectation(double le, double rho, int directions, double historyPower) {
-    const double rampEnd = std::max(1, directions / 2);
+inline double furnaceExpectation(double le, double rho, int directions, double historyPower, int plateau) {
+    const double rampEnd = std::max(1, plateau);
     double sum = 0, weights = 0, m = 0, r = 0;
     for (int k = 0; k < directions; ++k) {
         // relative to the ramp's last weight (early ones underflow to 0 at large powers)
