@@ -75,7 +75,6 @@ double Baker::Impl::noiseHalvesFactor() const {
 // directions against the model's 0.256 / 0.424 / 0.642 without f. With f
 // the model reads 0.242 / 0.396 / 0.603 (baked 0.246 / 0.389 / 0.609);
 // power 0: 0.293 at 16 (baked 0.293).
-// The model advances from the rounds it has run (a resumed bake runs it from 0).
 double Baker::Impl::lagMissedShare() const {
     const double r = tilerOptions.fixedPixelSize > 0.0 ? texelSize / tilerOptions.fixedPixelSize
                                                          : tilerOptions.pixelsPerTexel;
@@ -91,6 +90,7 @@ void Baker::Impl::LagModel::advance(double weightStep, bool refresh, double lamb
     ++rounds;
 }
 
+// The model advances from the rounds it has run (a resumed bake runs it from 0).
 double Baker::Impl::bounceLag() {
     const double lambda = stats.transportAlbedo;
     const int done = stats.directionsDone / shareCount();
@@ -104,18 +104,21 @@ double Baker::Impl::bounceLag() {
 
 // Where the history ramp ends: the earliest round (a power of two from 16,
 // at most half the rounds) after which the model above, run over the whole
-// schedule, leaves at most 1e-4 of the bounced light to come. The ramp fades
-// the early rounds, which read light maps with few bounces in them and are
-// then read again (the radiance is the running mean: a lag the rounds after
-// inherit); from the plateau on every round weighs the same. Until
-// 2026-12-05 the ramp ran over the first half of the rounds, which the lag
-// needs only where little light leaves (the rho 0.99 furnace keeps it): the
-// Cornell box (power 3) counted its rounds as 0.68 of as many equal ones and
-// read 0.83 % against the converged reference at 1024 directions (two
-// seeds); ending at round 64 (0.96) 0.66 %, with no more lag to see in the
-// mean (0.9985 of the reference's, as before). The bound is far under the
-// noise of any bake the bench measures (0.2 % at 4096 directions), and the
-// model's lag is below the bake's (the rho 0.99 furnace lags more than it).
+// schedule, leaves at most 0.01 / sqrt(directions) of the bounced light to
+// come: a hundredth of a texel's noise if one direction's sample of it
+// varied by its whole value (the bake's noise is smaller, but not that much:
+// the Cornell box 0.16 / sqrt(N)). The ramp fades the early rounds, which
+// read light maps with few bounces in them and are then read again (the
+// radiance is the running mean: a lag the rounds after inherit); from the
+// plateau on every round weighs the same. Until 2026-12-05 the ramp ran over
+// the first half of the rounds, which the lag needs only where little light
+// leaves (the rho 0.99 furnace keeps it): the Cornell box (power 3) counted
+// its rounds as 0.68 of as many equal ones and read 0.83 % against the
+// converged reference at 1024 directions (two seeds); ending at round 64
+// (0.96) 0.66 %, at 128 0.71 %, at 32 0.68 %, with no lag to see in the mean
+// (0.998-0.999 of the reference's either way). The model's lag is below the
+// bake's where the albedo is high (the rho 0.99 furnace lags more than it),
+// which the bound leaves room for.
 int Baker::Impl::chooseHistoryPlateau() const {
     const int half = std::max(1, rounds() / 2);
     if (options.historyPlateau > 0) return std::min(options.historyPlateau, half);
