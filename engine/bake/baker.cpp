@@ -95,7 +95,7 @@ nlohmann::json BakeStats::toJson() const {
     j["directions"] = {{"done", directionsDone}, {"total", directionsTotal}};
     j["bundle"] = {{"resolution_pixels", bundleResolution}, {"pixel_size_scene_units", pixelSize},
                    {"history_power", historyPower}, {"history_plateau", historyPlateau},
-                   {"transport_albedo", transportAlbedo},
+                   {"transport_albedo", transportAlbedo}, {"transport_albedo_slowest", transportAlbedoSlowest},
                    {"radiance_unit", radianceUnit}};
     auto pct = [&](double q) { return quantile(predictedOverActual, q); };
     auto size = [&](double q) { return quantile(tilePixelSizes, q); };
@@ -622,8 +622,10 @@ Status Baker::Impl::init(const Scene& scene) {
         albedos.push_back(m.albedo * (m.albedoTexture >= 0 ? textureMeans[size_t(m.albedoTexture)] : glm::vec3(1.0f)));
         doubleSided.push_back(m.doubleSided);
     }
-    const double rho = std::min(transportAlbedo(mesh, albedos, doubleSided), 0.99);
+    const TransportAlbedo transport = transportAlbedo(mesh, albedos, doubleSided);
+    const double rho = std::min(transport.lambda, 0.99);
     stats.transportAlbedo = rho;
+    stats.transportAlbedoSlowest = std::min(transport.slowest, 0.99);  // where the ramp's plateau waits for (noise.cpp)
     historyPower = options.historyPower >= 0 ? options.historyPower : defaultHistoryPower(rho);
     refreshEveryRound = std::max(64, int(std::ceil(std::log(1000.0) / (1.0 - rho))));
     stats.historyPower = historyPower;

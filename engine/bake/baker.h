@@ -114,6 +114,7 @@ struct BakeStats {
     double historyPower = 0;
     int historyPlateau = 0;           // rounds: the ramp's weights are equal from this one on
     double transportAlbedo = 0;       // the light's share kept per bounce (bake/transport_albedo.h)
+    double transportAlbedoSlowest = 0;  // the share a pocket that keeps its light longest keeps (its `slowest`)
     double radianceUnit = 1;          // the light-map state holds radiance / this (a power of two; fp16 range)
     int64_t tilesDrawn = 0;
     int64_t leafRunUpdates = 0;       // update passes over a run of several whole leaves at once (bundle_tracer.h)

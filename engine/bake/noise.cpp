@@ -104,27 +104,30 @@ double Baker::Impl::bounceLag() {
 
 // Where the history ramp ends: the earliest round (a power of two from 16,
 // at most half the rounds) after which the model above, run over the whole
-// schedule, leaves at most 0.01 / sqrt(directions) of the bounced light to
-// come: a hundredth of a texel's noise if one direction's sample of it
-// varied by its whole value (the bake's noise is smaller, but not that much:
-// the Cornell box 0.16 / sqrt(N)). The ramp fades the early rounds, which
-// read light maps with few bounces in them and are then read again (the
-// radiance is the running mean: a lag the rounds after inherit); from the
-// plateau on every round weighs the same. Until 2026-12-05 the ramp ran over
-// the first half of the rounds, which the lag needs only where little light
-// leaves (the rho 0.99 furnace keeps it): the Cornell box (power 3) counted
-// its rounds as 0.68 of as many equal ones and read 0.83 % against the
-// converged reference at 1024 directions (two seeds); ending at round 64
-// (0.96) 0.66 %, at 128 0.71 %, at 32 0.68 %, with no lag to see in the mean
-// (0.998-0.999 of the reference's either way). The model's lag is below the
-// bake's where the albedo is high (the rho 0.99 furnace lags more than it),
-// which the bound leaves room for.
+// schedule for the scene's slowest mode (transport_albedo.h `slowest`: a
+// pocket that keeps its light), leaves at most 0.02 / sqrt(directions) of
+// its bounced light to come: a fiftieth of a texel's noise if one
+// direction's sample of it varied by its whole value (the bake's is smaller,
+// but not by that much: the Cornell box's 0.16 / sqrt(N)). The ramp fades
+// the early rounds, which read light maps with few bounces in them and are
+// then read again (the radiance is the running mean: a lag the rounds after
+// inherit); from the plateau on every round weighs the same. Until
+// 2026-12-05 the ramp ran over the first half of the rounds, which the lag
+// needs only where light is kept long (the rho 0.99 furnace keeps it;
+// mixed_lighting's slowest, 0.93, and the city's, 0.58, too): the Cornell
+// box (power 3) counted its rounds as 0.68 of as many equal ones and read
+// 0.83 % against the converged reference at 1024 directions (two seeds);
+// ending at round 64 (0.96) 0.66 %, at 128 0.71 %, at 32 0.68 %, with no
+// lag to see in the mean (0.998-0.999 of the reference's either way). With
+// the scene's lambda (5 bounces) instead of its slowest mode the shared
+// Cornell box ended at 32 and its brightest texels, in the gap over its
+// light panel, read 0.9 % low (0.5 % with the ramp over half).
 int Baker::Impl::chooseHistoryPlateau() const {
     const int half = std::max(1, rounds() / 2);
     if (options.historyPlateau > 0) return std::min(options.historyPlateau, half);
-    const double lambda = stats.transportAlbedo, missed = lagMissedShare();
+    const double lambda = stats.transportAlbedoSlowest, missed = lagMissedShare();
     if (!(lambda > 0.0)) return std::min(16, half);
-    const double bound = 0.01 / std::sqrt(double(std::max(1, options.directions)));
+    const double bound = 0.02 / std::sqrt(double(std::max(1, options.directions)));
     for (int plateau = 16; plateau < half; plateau *= 2) {
         LagModel m;
         for (int j = 0; j < rounds(); ++j)

@@ -9,7 +9,8 @@
 namespace bb {
 namespace {
 
-constexpr int kBounces = 5;
+constexpr int kBounces = 5;       // lambda = E_5 / E_4
+constexpr int kSlowBounces = 24;  // slowest = E_24 / E_23
 
 struct Triangle {
     glm::vec3 p0, e1, e2;
@@ -18,10 +19,10 @@ struct Triangle {
 
 }  // namespace
 
-double transportAlbedo(const BakeMesh& mesh, const std::vector<glm::vec3>& albedo, const std::vector<bool>& doubleSided,
-                       int paths) {
+TransportAlbedo transportAlbedo(const BakeMesh& mesh, const std::vector<glm::vec3>& albedo,
+                                const std::vector<bool>& doubleSided, int paths) {
     const size_t n = mesh.triangles.size();
-    if (n == 0 || paths <= 0) return 0.0;
+    if (n == 0 || paths <= 0) return {};
     std::vector<Triangle> tris(n);
     std::vector<double> cdf(n);
     double area = 0.0;
@@ -40,20 +41,22 @@ double transportAlbedo(const BakeMesh& mesh, const std::vector<glm::vec3>& albed
         area += 0.5 * double(len);
         cdf[t] = area;
     }
-    if (area <= 0.0) return 0.0;
+    if (area <= 0.0) return {};
 
     RTCDevice device = rtcNewDevice("threads=1");
-    if (!device) return 0.0;
+    if (!device) return {};
     RTCScene scene = commitBakeMeshScene(device, mesh, RTC_BUILD_QUALITY_MEDIUM);
     if (!scene) {
         rtcReleaseDevice(device);
-        return 0.0;
+        return {};
     }
 
     const float offset = rayOffset(mesh);
 
-    std::vector<glm::dvec3> sums(kBounces + 1, glm::dvec3(0.0));  // E_k x paths, k = 0..kBounces
-    SplitMix64 rng{0x5eed5eedull};
+    std::vector<glm::dvec3> sums(kSlowBounces + 1, glm::dvec3(0.0));  // E_k x paths, k = 0..kSlowBounces
+    // the first kBounces bounces from one sequence, their continuations from
+    // another: lambda the same numbers whatever the slowest's bounces draw
+    SplitMix64 rng{0x5eed5eedull}, slowRng{0x510e510eull};
     for (int p = 0; p < paths; ++p) {
         // a point by area, then k cosine rays
         const double pick = (double(p) + double(rng.uniformFloat())) / double(paths) * area;
@@ -61,10 +64,11 @@ double transportAlbedo(const BakeMesh& mesh, const std::vector<glm::vec3>& albed
         t = std::min(t, n - 1);
         bool flip = false;  // on a double-sided triangle's back
         glm::vec3 weight(1.0f);
-        for (int k = 0; k <= kBounces; ++k) {
+        for (int k = 0; k <= kSlowBounces; ++k) {
             const Triangle& tri = tris[t];
             const glm::vec3 normal = flip ? -tri.n : tri.n;
-            float u = rng.uniformFloat(), v = rng.uniformFloat();
+            SplitMix64& pointRng = k <= kBounces ? rng : slowRng;
+            float u = pointRng.uniformFloat(), v = pointRng.uniformFloat();
             if (u + v > 1.0f) {
                 u = 1.0f - u;
                 v = 1.0f - v;
@@ -72,9 +76,10 @@ double transportAlbedo(const BakeMesh& mesh, const std::vector<glm::vec3>& albed
             const glm::vec3 point = tri.p0 + u * tri.e1 + v * tri.e2;
             weight *= albedo[mesh.triangles[t].material];
             sums[size_t(k)] += glm::dvec3(weight);
-            if (k == kBounces) break;
+            if (k == kSlowBounces) break;
             // a cosine direction about the normal
-            const float r = std::sqrt(rng.uniformFloat()), phi = 6.28318531f * rng.uniformFloat();
+            SplitMix64& rayRng = k < kBounces ? rng : slowRng;
+            const float r = std::sqrt(rayRng.uniformFloat()), phi = 6.28318531f * rayRng.uniformFloat();
             const glm::vec3 axis = std::abs(normal.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
             const glm::vec3 tx = glm::normalize(glm::cross(axis, normal)), ty = glm::cross(normal, tx);
             const glm::vec3 dir = r * std::cos(phi) * tx + r * std::sin(phi) * ty +
@@ -89,10 +94,17 @@ double transportAlbedo(const BakeMesh& mesh, const std::vector<glm::vec3>& albed
     }
     rtcReleaseScene(scene);
     rtcReleaseDevice(device);
-    double lambda = 0.0;
-    for (int c = 0; c < 3; ++c)
-        if (sums[kBounces - 1][c] > 0.0) lambda = std::max(lambda, sums[kBounces][c] / sums[kBounces - 1][c]);
-    return std::min(lambda, 0.999);
+    // E_k / E_(k-1), the largest channel's; 0 where no path made k bounces
+    auto ratio = [&](int k) {
+        double lambda = 0.0;
+        for (int c = 0; c < 3; ++c)
+            if (sums[size_t(k - 1)][c] > 0.0) lambda = std::max(lambda, sums[size_t(k)][c] / sums[size_t(k - 1)][c]);
+        return std::min(lambda, 0.999);
+    };
+    TransportAlbedo out;
+    out.lambda = ratio(kBounces);
+    out.slowest = std::max(out.lambda, ratio(kSlowBounces));
+    return out;
 }
 
 }  // namespace bb

@@ -28,9 +28,17 @@
 
 namespace bb {
 
+struct TransportAlbedo {
+    double lambda = 0.0;  // E_5 / E_4, in [0, 1)
+    // E_24 / E_23 (at least lambda): the paths still bouncing by then are
+    // those a pocket of the scene keeps (the shared Cornell box's 0.9 mm gap
+    // between its light panel and the ceiling), whose light settles slowest
+    double slowest = 0.0;
+};
+
 // `albedo`: per material, the linear RGB albedo (times its texture's mean);
-// `doubleSided`: per material. Returns lambda in [0, 1).
-double transportAlbedo(const BakeMesh& mesh, const std::vector<glm::vec3>& albedo,
-                       const std::vector<bool>& doubleSided, int paths = 16384);
+// `doubleSided`: per material.
+TransportAlbedo transportAlbedo(const BakeMesh& mesh, const std::vector<glm::vec3>& albedo,
+                                const std::vector<bool>& doubleSided, int paths = 16384);
 
 }  // namespace bb

@@ -16,10 +16,10 @@
 namespace bb::test {
 namespace {
 
-double lambdaOf(const Scene& scene) {
+TransportAlbedo transportOf(const Scene& scene) {
     auto layout = packLayout(scene, 64, 8.0f);
     EXPECT_TRUE(layout) << layout.error();
-    if (!layout) return -1.0;
+    if (!layout) return {-1.0, -1.0};
     const BakeMesh mesh = buildBakeMesh(scene, *layout);
     std::vector<glm::vec3> albedo;
     std::vector<bool> doubleSided;
@@ -29,6 +29,8 @@ double lambdaOf(const Scene& scene) {
     }
     return transportAlbedo(mesh, albedo, doubleSided);
 }
+
+double lambdaOf(const Scene& scene) { return transportOf(scene).lambda; }
 
 TEST(TransportAlbedo, AClosedRoomOfOneAlbedoKeepsThatAlbedo) {
     Scene scene;
@@ -63,6 +65,29 @@ TEST(TransportAlbedo, AnOpenTopBoxKeepsBetweenFourFifthsOfItsAlbedoAndItsAlbedo)
     std::printf("[transport albedo] open-top box of albedo 0.6: %.4f\n", lambda);
     EXPECT_GE(lambda, 0.8 * 0.6 - 0.01);
     EXPECT_LT(lambda, 0.6 - 0.01);
+}
+
+// The slowest: an open-top box of albedo 0.6 (its light settles at ~0.48 a
+// bounce, "AnOpenTopBox..." below) beside a closed room of albedo 0.9 with
+// 1/80 of its area: five bounces in, the box's light still outweighs the
+// room's (lambda near 0.5), while the paths still bouncing after 24 are the
+// room's (0.9). In a closed room of one albedo both are that albedo.
+TEST(TransportAlbedo, APocketThatKeepsItsLightSetsTheSlowest) {
+    Scene scene;
+    addBox(scene, glm::vec3(0.0f), glm::vec3(1.0f), addMaterial(scene, glm::vec3(0.6f)), false, "box");
+    scene.instances.erase(scene.instances.begin() + 2);  // its top (+y), as below
+    for (size_t i = 2; i < scene.instances.size(); ++i) scene.instances[i].node = int(i);
+    addBox(scene, glm::vec3(4.0f, 0.0f, 0.0f), glm::vec3(0.1f), addMaterial(scene, glm::vec3(0.9f)), false, "room");
+    const TransportAlbedo t = transportOf(scene);
+    std::printf("[transport albedo] open box 0.6 beside a small room 0.9: lambda %.4f, slowest %.4f\n", t.lambda,
+                t.slowest);
+    EXPECT_LT(t.lambda, 0.7);
+    EXPECT_NEAR(t.slowest, 0.9, 0.01);
+    Scene room;
+    addBox(room, glm::vec3(0.0f), glm::vec3(1.0f), addMaterial(room, glm::vec3(0.7f)), false, "room");
+    const TransportAlbedo r = transportOf(room);
+    EXPECT_NEAR(r.lambda, 0.7, 1e-3);
+    EXPECT_NEAR(r.slowest, 0.7, 1e-3);
 }
 
 TEST(TransportAlbedo, ADoubleSidedPanelReflectsOnBothSides) {
