@@ -21,7 +21,7 @@ namespace bb {
 
 void Baker::Impl::beginDirection(int k) {
     const glm::vec3 d = directions[size_t(k)];
-    // history ramp: weight min(j+1, rounds/2)^power relative to the stored
+    // history ramp: weight min(j+1, plateau)^power relative to the stored
     // scale, j the round (the direction, baked alone): a round adds a bounce
     const double logWeight = rampLogWeight(k / shareCount());
     double sampleWeight = std::exp(logWeight - accumLogScale);

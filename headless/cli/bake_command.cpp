@@ -69,7 +69,7 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
                    "Weight direction k by min(k, plateau)^p to fade early, few-bounce directions (-1 = from the scene's transport albedo, the light's share kept per bounce)")
         ->capture_default_str();
     cmd.add_option("--history-plateau", a.historyPlateau,
-                   "The direction from which every one weighs the same (0 = the earliest that leaves under 1e-4 of the bounced light to come, at most N/2)")
+                   "The direction from which every one weighs the same (0 = the earliest after which the bounce-lag model leaves under 0.02/sqrt(N) of the bounced light to come, at most N/2)")
         ->check(CLI::NonNegativeNumber)
         ->capture_default_str();
     cmd.add_option("--direct", a.direct,
