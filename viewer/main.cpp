@@ -61,6 +61,7 @@ struct ViewerArgs {
     std::string env;
     std::string rounding = "stochastic";
     float historyPower = -1.0f;
+    int historyPlateau = 0;
     std::string supersample = "auto";  // auto | 1 | 2 | 4, as the bake command's
     // viewer
     int width = 1280, height = 720;
@@ -333,7 +334,7 @@ Status Viewer::saveLightmaps(const std::string& dir) {
                      {"sky", args_.sky}, {"env", args_.env}, {"rounding", args_.rounding},
                      {"uv_layout", args_.scene.uvLayout}, {"resolution", args_.scene.resolution},
                      {"texel_density", args_.scene.texelDensity}, {"history_power", baker_->stats().historyPower},
-                     {"supersample", args_.supersample}};
+                     {"history_plateau", baker_->stats().historyPlateau}, {"supersample", args_.supersample}};
     info.wallSeconds = bakeSeconds_;
     return writeBakeOutputs(dir, loaded_.scene, loaded_.layout, baker_->readLightmaps(), baker_->stats().toJson(), info);
 }
@@ -712,6 +713,10 @@ int runViewer(int argc, char** argv) {
         ->capture_default_str();
     app.add_option("--history-power", a.historyPower, "History ramp power (-1 = from the scene's transport albedo)")
         ->capture_default_str();
+    app.add_option("--history-plateau", a.historyPlateau,
+                   "The direction from which every one weighs the same (0 = where the bounce-lag model allows)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
     cli::addSupersampleOption(app, a.supersample);
     app.add_option("--width", a.width, "Window width")->check(CLI::Range(64, 16384))->capture_default_str();
     app.add_option("--height", a.height, "Window height")->check(CLI::Range(64, 16384))->capture_default_str();
@@ -760,6 +765,7 @@ int runViewer(int argc, char** argv) {
     options.sky = *sky;
     options.rounding = a.rounding == "nearest" ? Rounding::Nearest : Rounding::Stochastic;
     options.historyPower = a.historyPower;
+    options.historyPlateau = a.historyPlateau;
     options.supersample = cli::supersampleValue(a.supersample);
     if (!a.env.empty()) {
         auto env = io::readImageRgb(a.env);
