@@ -92,7 +92,8 @@ void runFurnace(const FurnaceCase& fc) {
 TEST(FurnaceBake, Rho05Gives2Everywhere) { runFurnace({"assets/furnace/furnace.gltf", 0.5, 256, 0.04}); }
 
 // rho 0.9 at 1024 directions: mean within 0.3 % (issue 11; seed 1 reads
-// 9.9985, -0.015 %; 9.981 while the history ramp ran over half the directions)
+// 9.9932, -0.07 %, the ramp ending at 128; 9.981 while it ran over half the
+// directions)
 TEST(FurnaceBake, Rho09Gives10Everywhere) {
     runFurnace({"assets/furnace/furnace_rho09.gltf", 0.9, 1024, 0.04, BakeOptions::Tiling::Adaptive, 0.003});
 }
