@@ -711,12 +711,7 @@ int runViewer(int argc, char** argv) {
     app.add_option("--rounding", a.rounding, "fp16/RGBE conversion: stochastic or nearest")
         ->check(CLI::IsMember({"stochastic", "nearest"}))
         ->capture_default_str();
-    app.add_option("--history-power", a.historyPower, "History ramp power (-1 = from the scene's transport albedo)")
-        ->capture_default_str();
-    app.add_option("--history-plateau", a.historyPlateau,
-                   "The direction from which every one weighs the same (0 = where the bounce-lag model allows)")
-        ->check(CLI::NonNegativeNumber)
-        ->capture_default_str();
+    cli::addHistoryOptions(app, a.historyPower, a.historyPlateau);
     cli::addSupersampleOption(app, a.supersample);
     app.add_option("--width", a.width, "Window width")->check(CLI::Range(64, 16384))->capture_default_str();
     app.add_option("--height", a.height, "Window height")->check(CLI::Range(64, 16384))->capture_default_str();

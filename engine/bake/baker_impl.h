@@ -219,6 +219,9 @@ struct Baker::Impl {
         double lag(double lambda) const { return std::max(0.0, 1.0 - mean * (1.0 - lambda)); }
     } lagModel;
     double lagMissedShare() const;  // noise.cpp: the model's share of samples that weigh 0
+    // noise.cpp: `m` advanced through the schedule's rounds up to `rounds`
+    // under a ramp ending at `plateau`, for a mode that keeps `lambda` a bounce
+    void runLagModel(LagModel& m, int rounds, int plateau, double lambda) const;
     int directionsGoal() const { return stats.stoppedAtTargetNoise ? stats.directionsDone : options.directions; }
 };
 

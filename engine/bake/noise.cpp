@@ -90,16 +90,20 @@ void Baker::Impl::LagModel::advance(double weightStep, bool refresh, double lamb
     ++rounds;
 }
 
+void Baker::Impl::runLagModel(LagModel& m, int rounds, int plateau, double lambda) const {
+    const double missed = lagMissedShare();
+    for (int j = m.rounds; j < rounds; ++j)
+        m.advance(j > 0 ? std::exp(rampLogWeight(j - 1, plateau) - rampLogWeight(j, plateau)) : 1.0,
+                  refreshesAfter(j), lambda, missed);
+}
+
 // The model advances from the rounds it has run (a resumed bake runs it from 0).
 double Baker::Impl::bounceLag() {
     const double lambda = stats.transportAlbedo;
     const int done = stats.directionsDone / shareCount();
     if (!(lambda > 0.0) || done < 1) return 0.0;
-    const double missed = lagMissedShare();
-    LagModel& m = lagModel;
-    for (int j = m.rounds; j < done; ++j)
-        m.advance(j > 0 ? std::exp(rampLogWeight(j - 1) - rampLogWeight(j)) : 1.0, refreshesAfter(j), lambda, missed);
-    return m.lag(lambda);
+    runLagModel(lagModel, done, historyPlateau, lambda);
+    return lagModel.lag(lambda);
 }
 
 // Where the history ramp ends: the earliest round (a power of two from 16,
@@ -125,14 +129,12 @@ double Baker::Impl::bounceLag() {
 int Baker::Impl::chooseHistoryPlateau() const {
     const int half = std::max(1, rounds() / 2);
     if (options.historyPlateau > 0) return std::min(options.historyPlateau, half);
-    const double lambda = stats.transportAlbedoSlowest, missed = lagMissedShare();
+    const double lambda = stats.transportAlbedoSlowest;
     if (!(lambda > 0.0)) return std::min(16, half);
     const double bound = 0.02 / std::sqrt(double(std::max(1, options.directions)));
     for (int plateau = 16; plateau < half; plateau *= 2) {
         LagModel m;
-        for (int j = 0; j < rounds(); ++j)
-            m.advance(j > 0 ? std::exp(rampLogWeight(j - 1, plateau) - rampLogWeight(j, plateau)) : 1.0,
-                      refreshesAfter(j), lambda, missed);
+        runLagModel(m, rounds(), plateau, lambda);
         if (m.lag(lambda) <= bound) return plateau;
     }
     return half;

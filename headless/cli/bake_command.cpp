@@ -65,13 +65,7 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
     cmd.add_option("--rounding", a.rounding, "fp16/RGBE conversion: stochastic (unbiased) or nearest (biased, for tests)")
         ->check(CLI::IsMember({"stochastic", "nearest"}))
         ->capture_default_str();
-    cmd.add_option("--history-power", a.historyPower,
-                   "Weight direction k by min(k, plateau)^p to fade early, few-bounce directions (-1 = from the scene's transport albedo, the light's share kept per bounce)")
-        ->capture_default_str();
-    cmd.add_option("--history-plateau", a.historyPlateau,
-                   "The direction from which every one weighs the same (0 = the earliest after which the bounce-lag model leaves under 0.02/sqrt(N) of the bounced light to come, at most N/2)")
-        ->check(CLI::NonNegativeNumber)
-        ->capture_default_str();
+    addHistoryOptions(cmd, a.historyPower, a.historyPlateau);
     cmd.add_option("--direct", a.direct,
                    "Direct light from emissive triangles: explicit (form factor x shadow cube maps), bundles, or auto "
                    "(explicit for small emitters)")

@@ -262,6 +262,16 @@ void addSupersampleOption(CLI::App& cmd, std::string& supersample) {
         ->capture_default_str();
 }
 
+void addHistoryOptions(CLI::App& cmd, float& power, int& plateau) {
+    cmd.add_option("--history-power", power,
+                   "Weight direction k by min(k, plateau)^p to fade early, few-bounce directions (-1 = from the scene's transport albedo, the light's share kept per bounce)")
+        ->capture_default_str();
+    cmd.add_option("--history-plateau", plateau,
+                   "The direction from which every one weighs the same (0 = the earliest after which the bounce-lag model leaves under 0.02/sqrt(N) of the bounced light to come, at most N/2)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+}
+
 int supersampleValue(const std::string& supersample) { return supersample == "auto" ? 0 : std::stoi(supersample); }
 
 }  // namespace bb::cli

@@ -62,6 +62,8 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& args);
 void addSeamsOption(CLI::App& cmd, std::string& seams);
 // --supersample auto|1|2|4 (bake and viewer), and its BakeOptions::supersample (auto: 0)
 void addSupersampleOption(CLI::App& cmd, std::string& supersample);
+// --history-power and --history-plateau (BakeOptions::historyPower, historyPlateau)
+void addHistoryOptions(CLI::App& cmd, float& power, int& plateau);
 int supersampleValue(const std::string& supersample);
 
 // Parses "r,g,b" (three finite numbers >= 0) or a single number for grey.
