@@ -8,6 +8,7 @@
 #include <cstring>
 
 #include "bake/baker_impl.h"
+#include "bake/cube_scissor.h"
 #include "bake/directions.h"
 #include "bake/rounding.h"
 #include "core/check.h"
@@ -48,9 +49,13 @@ struct DistanceCube {
 
     // Draws the whole mesh but triangle `own` (an emitter sample's) into the
     // six faces around `point`, turned by `orientation` (cube from world),
-    // distances up to farPlane.
+    // distances up to farPlane. `front` (a single-sided emitter's normal):
+    // only the directions in front of the emitter are looked up (behind it
+    // nothing is lit, direct/emitter.frag), so each face draws only the part
+    // of it that sees them (faceScissor) and a face wholly behind draws
+    // nothing; every face is cleared whole all the same.
     void render(GLuint vertexArray, const gl::Program& program, const glm::vec3& point, const glm::mat3& orientation,
-                float nearPlane, float farPlane, uint32_t own = 0xffffffffu) {
+                float nearPlane, float farPlane, uint32_t own = 0xffffffffu, const glm::vec3* front = nullptr) {
         cubeFromWorld = orientation;
         const glm::mat4 cubeFromPoint = glm::mat4(orientation) * glm::translate(glm::mat4(1.0f), -point);
         static const glm::vec3 faceDir[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
@@ -72,7 +77,15 @@ struct DistanceCube {
             glUniformMatrix4fv(program.uniform("clipFromWorld"), 1, GL_FALSE, &clipFromWorld[0][0]);
             glClearNamedFramebufferuiv(fbo.id(), GL_COLOR, 0, farValue);
             glClearNamedFramebufferfi(fbo.id(), GL_DEPTH_STENCIL, 0, 1.0f, 0);
+            if (front) {
+                const glm::mat3 viewFromWorld = glm::mat3(glm::lookAt(glm::vec3(0.0f), faceDir[f], faceUp[f])) * orientation;
+                const glm::ivec4 rect = faceScissor(viewFromWorld * *front, size);
+                if (rect.z <= 0 || rect.w <= 0) continue;
+                glEnable(GL_SCISSOR_TEST);
+                glScissor(rect.x, rect.y, rect.z, rect.w);
+            }
             chunks.drawArrays(program.id(), 0, chunks.triangleCount());
+            glDisable(GL_SCISSOR_TEST);
         }
         glDisable(GL_DEPTH_TEST);
     }
@@ -123,6 +136,33 @@ void Baker::Impl::bakeSun() {
             }
         foldDirect(true);  // this sun's mean over its valid samples, added to the direct map
     }
+}
+
+// A face's pixels in front of the plane: the lookups near the plane step up
+// to a texel's angle past the direction they test and read the texel they
+// fall in, so a margin of 4 texels' angle keeps them well inside.
+glm::ivec4 faceScissor(const glm::vec3& m, int size) {
+    // m . (x, y, -1) >= -slack, with slack = sin(4 texels' angle) |m| sqrt(3)
+    // (|(x, y, -1)| <= sqrt(3) on the face): the texels' angle is at most 2 / size
+    const float slack = std::sin(8.0f / float(size)) * glm::length(m) * std::sqrt(3.0f);
+    const auto inside = [&](glm::vec2 p) { return m.x * p.x + m.y * p.y - m.z + slack; };
+    // the square [-1, 1]^2 clipped to the half-plane inside >= 0 (Sutherland-Hodgman, one plane)
+    const glm::vec2 square[4] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+    glm::vec2 lo(2.0f), hi(-2.0f);
+    for (int k = 0; k < 4; ++k) {
+        const glm::vec2 a = square[k], b = square[(k + 1) % 4];
+        const float da = inside(a), db = inside(b);
+        if (da >= 0.0f) lo = glm::min(lo, a), hi = glm::max(hi, a);
+        if ((da >= 0.0f) != (db >= 0.0f)) {
+            const glm::vec2 c = a + (b - a) * (da / (da - db));
+            lo = glm::min(lo, c), hi = glm::max(hi, c);
+        }
+    }
+    if (lo.x > hi.x) return glm::ivec4(0);
+    // to pixels, a pixel wider each way for the rounding
+    const glm::ivec2 p0 = glm::clamp(glm::ivec2(glm::floor((lo + 1.0f) * 0.5f * float(size))) - 1, 0, size);
+    const glm::ivec2 p1 = glm::clamp(glm::ivec2(glm::ceil((hi + 1.0f) * 0.5f * float(size))) + 1, 0, size);
+    return glm::ivec4(p0, p1 - p0);
 }
 
 bool Baker::Impl::useExplicitEmitters() const {
@@ -260,7 +300,8 @@ void Baker::Impl::bakeEmitters() {
             glm::vec3 point = a + float(su) * (b - a) + float(sv) * (c - a) + n * (1e-4f * pixelSize);
             // distance cube map
             const glm::mat3 orientation(randomRotation(hash(options.seed, e.triangle, uint64_t(i) + (1ull << 32))));
-            cube.render(vao.id(), distanceProgram, point, orientation, nearPlane, farPlane, uint32_t(e.triangle));
+            cube.render(vao.id(), distanceProgram, point, orientation, nearPlane, farPlane, uint32_t(e.triangle),
+                        doubleSided ? nullptr : &n);
             // accumulate this sample's share into the direct map, page by page
             for (const gl::Program* p : {&emitterProgram, &emitterCurvedProgram}) {
                 glUseProgram(p->id());
