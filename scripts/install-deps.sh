@@ -7,7 +7,7 @@ set -eu
 PACKAGES="
 g++ cmake make pkg-config python3 python3-glad
 libegl-dev libegl-mesa0 libgl1-mesa-dri libgl-dev libosmesa6-dev
-libglm-dev libopenimageio-dev libimath-dev libtinygltf-dev libstb-dev
+libglm-dev libopenexr-dev zlib1g-dev libimath-dev libtinygltf-dev libstb-dev
 nlohmann-json3-dev libcli11-dev libgtest-dev libembree-dev
 libglfw3-dev libimgui-dev xvfb xauth python3-matplotlib openimageio-tools libeigen3-dev
 clang libclang-rt-14-dev

@@ -18,7 +18,7 @@
 #include <tuple>
 
 #include "bake/bake_output.h"
-#include "export/png_codec.h"
+#include "io/stb_codec.h"
 #include "io/image_io.h"
 #include "render/scene_renderer.h"
 

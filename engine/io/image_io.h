@@ -1,4 +1,4 @@
-// Image and JSON output through OpenImageIO and nlohmann-json. Every writer
+// Image and JSON output through OpenEXR, stb and nlohmann-json. Every writer
 // goes to "<path>.tmp-<pid>" first and renames over `path`, so OUTDIR never
 // holds a partial or corrupt file.
 #pragma once
@@ -27,7 +27,7 @@ struct ImageRgb {
 
 void flipRows(ImageRgb& image);
 
-// RGB EXR (OpenEXR via OIIO), ZIP compression, plus string attributes (e.g.
+// RGB EXR (OpenEXR), ZIP compression, plus string attributes (e.g.
 // "bundlebake:units" = "L_lm = E/pi"): half floats, or 32-bit floats when a
 // value is beyond half's range (65504), so nothing is clamped.
 Status writeExr(const std::string& path, const ImageRgb& image,
@@ -37,16 +37,20 @@ Status writeExr(const std::string& path, const ImageRgb& image,
 // 16384 x 8192 environment map is 128 M. Checked before any allocation.
 constexpr int64_t MAX_IMAGE_PIXELS = int64_t(1) << 28;
 
-// Reads any OIIO-readable image (EXR, HDR, PNG...) as linear RGB float
-// (8-bit formats are taken as sRGB and linearized). Error names the file;
-// images larger than MAX_IMAGE_PIXELS are refused before allocation.
+// Reads an image as linear RGB float: EXR (its first part: R, G, B, else one
+// channel replicated) through OpenEXR; Radiance HDR and PNG (8 or 16 bits)
+// through stb_image (io/stb_codec.h). EXR and HDR are linear; a PNG is decoded
+// as sRGB unless its gAMA chunk says otherwise (gAMA 1.0: linear, as writePng
+// writes a linear PNG). Error names the file; images larger than
+// MAX_IMAGE_PIXELS are refused before allocation.
 Expected<ImageRgb> readImageRgb(const std::string& path);
 
 // 8-bit sRGB PNG of a linear image: scaled by 2^exposure, then ACES-fitted
 // filmic tone map (Narkowicz 2015), then sRGB encoding.
 Status writePngToneMapped(const std::string& path, const ImageRgb& image, float exposure = 0.0f);
 
-// 8-bit PNG written as is (values clamped to [0,1], sRGB-encoded if `srgb`).
+// 8-bit PNG written as is (values clamped to [0,1]), sRGB-encoded with an sRGB
+// chunk if `srgb`, else linear with gAMA 1.0.
 Status writePng(const std::string& path, const ImageRgb& image, bool srgb = true);
 
 // Pretty-printed JSON (2-space indent), atomically.

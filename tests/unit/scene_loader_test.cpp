@@ -11,11 +11,11 @@
 #include <string>
 #include <vector>
 
-#include <OpenImageIO/imageio.h>
 #include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
 #include "core/log.h"
+#include "io/stb_codec.h"
 #include "scene/scene.h"
 
 namespace bb {
@@ -152,12 +152,10 @@ json onePrimitiveScene(GltfBuilder& b, const std::string& meshName, json primiti
 }
 
 void writePng(const std::string& path, int w, int h, int channels, const std::vector<unsigned char>& pixels) {
-    auto out = OIIO::ImageOutput::create(path);
-    ASSERT_TRUE(out) << path;
-    OIIO::ImageSpec spec(w, h, channels, OIIO::TypeDesc::UINT8);
-    ASSERT_TRUE(out->open(path, spec));
-    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
-    ASSERT_TRUE(out->close());
+    ASSERT_EQ(pixels.size(), size_t(w) * size_t(h) * size_t(channels));
+    auto png = encodePng(pixels.data(), w, h, channels);
+    ASSERT_TRUE(png) << png.error();
+    std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(png->data()), std::streamsize(png->size()));
 }
 
 float srgbToLinear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
