@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <bit>
 #include <cstring>
+#include <future>
 #include <cmath>
 #include <numeric>
 
@@ -16,6 +17,7 @@
 #include "core/check.h"
 #include "core/log.h"
 #include "core/memory.h"
+#include "core/parallel.h"
 #include "gl/gl.h"
 #include "gl/shader.h"
 #include "glsl/shared/bundle_layout.h"
@@ -317,10 +319,12 @@ std::vector<int32_t> Baker::Impl::bakeTexelOwners(int page, std::vector<uint8_t>
 void Baker::Impl::uploadPartialPoints() {
     const int res = layout.resolution;
     std::vector<BakeVertex> points;
-    for (int p = 0; p < layout.pageCount; ++p) {
+    std::vector<std::vector<std::pair<uint32_t, BakeVertex>>> pagePoints(size_t(layout.pageCount));  // (material, point)
+    parallelFor(pagePoints.size(), [&](size_t pageIndex) {  // each page its own points
+        const int p = int(pageIndex);
         std::vector<uint8_t> partial;
         const std::vector<int32_t> owners = bakeTexelOwners(p, &partial);
-        std::vector<std::pair<uint32_t, BakeVertex>> page;  // (material, point)
+        std::vector<std::pair<uint32_t, BakeVertex>>& page = pagePoints[pageIndex];
         for (size_t i = 0; i < owners.size(); ++i) {
             if (!partial[i]) continue;
             const uint32_t t = uint32_t(owners[i]);
@@ -344,7 +348,9 @@ void Baker::Impl::uploadPartialPoints() {
             page.emplace_back(mesh.triangles[t].material, point);
         }
         std::stable_sort(page.begin(), page.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-        for (const auto& [material, point] : page) {
+    });
+    for (int p = 0; p < layout.pageCount; ++p) {
+        for (const auto& [material, point] : pagePoints[size_t(p)]) {
             if (partialRuns.empty() || partialRuns.back().page != uint32_t(p) || partialRuns.back().material != material)
                 partialRuns.push_back({points.size(), 0, uint32_t(p), material});
             ++partialRuns.back().count;
@@ -378,12 +384,32 @@ void Baker::Impl::coveragePass() {
     GLint64 maxSsbo = 0;
     glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxSsbo);
     int64_t curvedRefs = 0, flatInstead = 0;
-    for (int p = 0; p < layout.pageCount; ++p) {
-        gl::readTexture(dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, codes.data());
+    // each page's texels on the CPU (pure functions of the mesh and layout), a
+    // page a core at a time; what follows in page order on this thread
+    struct PageTexels {
         std::vector<uint8_t> partial;
-        const std::vector<int32_t> owners = bakeTexelOwners(p, &partial);
-        const std::vector<TexelFootprint> footprints = texelFootprints(mesh, p, res, owners, charts);
-        curved[size_t(p)] = curvedTexels(mesh, p, res, owners, charts, partial, footprints);
+        std::vector<int32_t> owners;
+        std::vector<TexelFootprint> footprints;
+        int64_t shared = 0;
+    };
+    const int batch = int(std::clamp(std::thread::hardware_concurrency(), 1u, 16u));
+    std::vector<PageTexels> pageTexels;
+    for (int p = 0; p < layout.pageCount; ++p) {
+        if (p % batch == 0) {
+            pageTexels.assign(size_t(std::min(batch, layout.pageCount - p)), PageTexels{});
+            parallelFor(pageTexels.size(), [&, first = p](size_t i) {
+                PageTexels& t = pageTexels[i];
+                const int page = first + int(i);
+                t.owners = bakeTexelOwners(page, &t.partial);
+                t.footprints = texelFootprints(mesh, page, res, t.owners, charts);
+                curved[size_t(page)] = curvedTexels(mesh, page, res, t.owners, charts, t.partial, t.footprints);
+                t.shared = int64_t(sharedTexels(mesh, page, res, t.owners, charts));
+            });
+        }
+        const std::vector<uint8_t>& partial = pageTexels[size_t(p % batch)].partial;
+        const std::vector<int32_t>& owners = pageTexels[size_t(p % batch)].owners;
+        const std::vector<TexelFootprint>& footprints = pageTexels[size_t(p % batch)].footprints;
+        gl::readTexture(dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, codes.data());
         std::erase_if(curved[size_t(p)], [&](const CurvedTexel& c) {
             if (codes[c.texel] != DILATION_SELF) return true;
             curvedRefs += int64_t(c.triangles.size());
@@ -402,7 +428,7 @@ void Baker::Impl::coveragePass() {
             ownerCharts[i] = uint16_t(owners[i] < 0 ? TEXEL_CHART_MASK : charts[size_t(owners[i])] & TEXEL_CHART_MASK);
         for (const CurvedTexel& c : curved[size_t(p)]) ownerCharts[c.texel] |= TEXEL_CURVED;
         gl::writeTexture(texelCharts.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_SHORT, 2, ownerCharts.data());
-        stats.sharedTexels += int64_t(sharedTexels(mesh, p, res, owners, charts));
+        stats.sharedTexels += pageTexels[size_t(p % batch)].shared;
         {
             std::vector<glm::uvec3> packed(footprints.size());
             for (size_t i = 0; i < packed.size(); ++i) {
@@ -637,6 +663,27 @@ Status Baker::Impl::init(const Scene& scene) {
     if (!s) return s;
     const int64_t gpuAtStart = MemoryTracker::gpu().current();
     uploadMesh();
+    // the noise estimate's sampled texels and, for a supersampled bake, their
+    // half-size texels' weights (the reduction's, fineTexelWeights: CPU work on
+    // the mesh and layout, its charts from uploadMesh; done beside the GL setup below)
+    const int outputRes = outputLayout.resolution, k = options.supersample;
+    stats.noiseStride = std::clamp(int(std::bit_floor(unsigned(std::max(1, outputRes / 256)))), 1, 16);
+    halfWidth = (outputRes + stats.noiseStride - 1) / stats.noiseStride * k;
+    std::future<std::vector<float>> noiseWeightValues = std::async(std::launch::async, [this, outputRes, k] {
+        const int pages = layout.pageCount;
+        std::vector<float> weights(size_t(halfWidth) * halfWidth * size_t(pages), 1.0f);
+        if (k > 1)
+            parallelFor(size_t(pages), [&](size_t p) {  // each page its own slice
+                const std::vector<float> fine = fineTexelWeights(mesh, charts, int(p), outputRes, k);
+                for (int y = 0; y < halfWidth; ++y)
+                    for (int x = 0; x < halfWidth; ++x) {
+                        const int fx = x / k * stats.noiseStride * k + x % k, fy = y / k * stats.noiseStride * k + y % k;
+                        weights[(p * halfWidth + size_t(y)) * halfWidth + size_t(x)] =
+                            fx < k * outputRes && fy < k * outputRes ? fine[size_t(fy) * size_t(k * outputRes) + size_t(fx)] : 0.0f;
+                    }
+            });
+        return weights;
+    });
     const int pages = layout.pageCount, res = layout.resolution;
     {
         MemoryCategory category("light maps");
@@ -658,25 +705,11 @@ Status Baker::Impl::init(const Scene& scene) {
     {
         // the noise estimate's half: about 256^2 sampled texels a page, every texel of small pages
         MemoryCategory category("noise estimate");
-        const int outputRes = outputLayout.resolution, k = options.supersample;
-        stats.noiseStride = std::clamp(int(std::bit_floor(unsigned(std::max(1, outputRes / 256)))), 1, 16);
-        halfWidth = (outputRes + stats.noiseStride - 1) / stats.noiseStride * k;
         halfAccum = gl::Texture::create2DArray("noise estimate: odd directions' accumulators", GL_RG32UI, halfWidth,
                                                halfWidth, pages);
         noiseTerms = gl::Texture::create2DArray("noise estimate terms", GL_RGBA32F, halfWidth / k, halfWidth / k, pages);
         // the sampled texels' half-size texels' weights (the reduction's: fineTexelWeights; whole texels 1)
         noiseWeights = gl::Texture::create2DArray("noise estimate: half-size texels' weights", GL_R16F, halfWidth, halfWidth, pages);
-        std::vector<float> weights(size_t(halfWidth) * halfWidth * size_t(pages), 1.0f);
-        for (int p = 0; p < pages && k > 1; ++p) {
-            const std::vector<float> fine = fineTexelWeights(mesh, charts, p, outputRes, k);
-            for (int y = 0; y < halfWidth; ++y)
-                for (int x = 0; x < halfWidth; ++x) {
-                    const int fx = x / k * stats.noiseStride * k + x % k, fy = y / k * stats.noiseStride * k + y % k;
-                    weights[(size_t(p) * halfWidth + size_t(y)) * halfWidth + size_t(x)] =
-                        fx < k * outputRes && fy < k * outputRes ? fine[size_t(fy) * size_t(k * outputRes) + size_t(fx)] : 0.0f;
-                }
-        }
-        gl::writeTexture(noiseWeights.id(), 0, 0, 0, halfWidth, halfWidth, pages, GL_RED, GL_FLOAT, 4, weights.data());
     }
     const uint32_t zero[4] = {0, 0, 0, 0};
     clearAccumulators();
@@ -705,6 +738,8 @@ Status Baker::Impl::init(const Scene& scene) {
     glDisable(GL_CULL_FACE);
     glDisable(GL_BLEND);
     coveragePass();
+    gl::writeTexture(noiseWeights.id(), 0, 0, 0, halfWidth, halfWidth, pages, GL_RED, GL_FLOAT, 4,
+                     noiseWeightValues.get().data());
 
     // The budget: what the light maps, mesh and materials (all fixed by the
     // scene and layout) leave goes to the bundle pass's node buffer and head

@@ -1,6 +1,7 @@
 #include "bake/supersample.h"
 
 #include "core/check.h"
+#include "core/parallel.h"
 
 namespace bb {
 
@@ -162,9 +163,13 @@ LightmapPages reduceLightmaps(const LightmapPages& fine, const BakeMesh& mesh, c
     CHECK(k == 2 || k == 4);
     LightmapPages out;
     out.resolution = res;
-    for (int p = 0; p < layout.pageCount; ++p) {
-        io::ImageRgb from = fine.pages[size_t(p)];
-        std::vector<uint8_t> fromCovered = fine.covered[size_t(p)], covered;
+    out.pages.resize(size_t(layout.pageCount));
+    out.covered.resize(size_t(layout.pageCount));
+    std::vector<LightmapPages> pageCounts(size_t(layout.pageCount));  // each page's filled and lost texels
+    parallelFor(size_t(layout.pageCount), [&](size_t pageIndex) {  // each page its own outputs
+        const int p = int(pageIndex);
+        io::ImageRgb from = fine.pages[pageIndex];
+        std::vector<uint8_t> fromCovered = fine.covered[pageIndex], covered;
         const std::vector<int32_t> half = halfTexelOwners(mesh, charts, p, res);
         if (k == 4) {  // quarter-size texels to half-size ones (their counts are not the output's)
             LightmapPages counts;
@@ -176,9 +181,13 @@ LightmapPages reduceLightmaps(const LightmapPages& fine, const BakeMesh& mesh, c
             fromCovered = covered;
         }
         const TexelQuarters quarters = texelQuarters(mesh, charts, p, res, texelOwners(mesh, p, res), half);
-        std::vector<glm::vec4> map = reduceLevel(from, fromCovered, charts, res, quarters, covered, out);
-        out.pages.push_back(dilatedImage(std::move(map), res, layout.padding + 1));
-        out.covered.push_back(std::move(covered));
+        std::vector<glm::vec4> map = reduceLevel(from, fromCovered, charts, res, quarters, covered, pageCounts[pageIndex]);
+        out.pages[pageIndex] = dilatedImage(std::move(map), res, layout.padding + 1);
+        out.covered[pageIndex] = std::move(covered);
+    });
+    for (const LightmapPages& c : pageCounts) {
+        out.filledTexels += c.filledTexels;
+        out.lostTexels += c.lostTexels;
     }
     return out;
 }

@@ -9,17 +9,16 @@
 #include "layout/layout.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <numeric>
 #include <string>
-#include <thread>
 #include <utility>
 
 #include "core/check.h"
 #include "core/log.h"
+#include "core/parallel.h"
 
 namespace bb {
 namespace {
@@ -657,18 +656,9 @@ Expected<Layout> computeLayout(Scene& scene, const LayoutOptions& options) {
 
     // charts, one mesh per task on every core (each mesh is its own; same bytes in any order)
     std::vector<MeshCharts> charts(groups.size());
-    {
-        std::atomic<size_t> next{0};
-        auto work = [&]() {
-            for (size_t g; (g = next++) < groups.size();)
-                charts[g] = makeCharts(scene.meshes[size_t(groups[g].mesh)], groups[g].metricFromObject, options.charts);
-        };
-        const size_t threads = std::min<size_t>({std::max(1u, std::thread::hardware_concurrency()), groups.size(), 16});
-        std::vector<std::thread> pool;
-        for (size_t k = 1; k < threads; ++k) pool.emplace_back(work);
-        work();
-        for (std::thread& t : pool) t.join();
-    }
+    parallelFor(groups.size(), [&](size_t g) {
+        charts[g] = makeCharts(scene.meshes[size_t(groups[g].mesh)], groups[g].metricFromObject, options.charts);
+    });
     const auto charted = Clock::now();
 
     GeneratedMeshes gen;

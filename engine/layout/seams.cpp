@@ -6,6 +6,8 @@
 #include <cstring>
 #include <tuple>
 
+#include "core/parallel.h"
+
 namespace bb {
 namespace {
 
@@ -137,11 +139,15 @@ Seams findSeams(const BakeMesh& mesh, int resolution, const SeamOptions& options
     // sample pairs: n per edge at the centres of n equal parts, where both
     // sides' charts own a texel of their lookups
     const std::vector<uint32_t> chartOf = findLightmapCharts(mesh);
+    // the texels' owners of the pages the seams lie on, a page a core
     std::vector<std::vector<int32_t>> owners(mesh.pageFirstTriangle.size() - 1);
-    auto ownerOf = [&](uint32_t page) -> const std::vector<int32_t>& {
-        if (owners[page].empty()) owners[page] = texelOwners(mesh, int(page), resolution);
-        return owners[page];
-    };
+    std::vector<uint8_t> seamPage(owners.size(), 0);
+    for (const auto& [first, second] : seamUses)
+        seamPage[mesh.triangles[uses[first].triangle].page] = seamPage[mesh.triangles[uses[second].triangle].page] = 1;
+    parallelFor(owners.size(), [&](size_t page) {
+        if (seamPage[page]) owners[page] = texelOwners(mesh, int(page), resolution);
+    });
+    auto ownerOf = [&](uint32_t page) -> const std::vector<int32_t>& { return owners[page]; };
     for (size_t seam = 0; seam < seamUses.size(); ++seam) {
         const EdgeUse& a = uses[seamUses[seam].first];
         const EdgeUse& b = uses[seamUses[seam].second];
@@ -165,13 +171,13 @@ Seams findSeams(const BakeMesh& mesh, int resolution, const SeamOptions& options
     }
     // the part of each texel on its chart, on the pages whose owners the seams needed
     out.texelArea.resize(owners.size());
-    for (size_t page = 0; page < owners.size(); ++page) {
-        if (owners[page].empty()) continue;
+    parallelFor(owners.size(), [&](size_t page) {  // each page its own areas
+        if (owners[page].empty()) return;
         const std::vector<TexelFootprint> footprints = texelFootprints(mesh, int(page), resolution, owners[page], chartOf);
         out.texelArea[page].resize(footprints.size());
         for (size_t i = 0; i < footprints.size(); ++i)
             out.texelArea[page][i] = owners[page][i] >= 0 ? footprints[i].area : uint8_t(0);
-    }
+    });
     return out;
 }
 
