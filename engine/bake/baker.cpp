@@ -320,10 +320,15 @@ void Baker::Impl::uploadPartialPoints() {
     const int res = layout.resolution;
     std::vector<BakeVertex> points;
     std::vector<std::vector<std::pair<uint32_t, BakeVertex>>> pagePoints(size_t(layout.pageCount));  // (material, point)
+    const bool keep = int64_t(res) * res * layout.pageCount * int64_t(sizeof(int32_t) + 1) <= kKeptOwnersBytes;
+    keptOwners.assign(keep ? size_t(layout.pageCount) : 0, PageOwners{});
     parallelFor(pagePoints.size(), [&](size_t pageIndex) {  // each page its own points
         const int p = int(pageIndex);
-        std::vector<uint8_t> partial;
-        const std::vector<int32_t> owners = bakeTexelOwners(p, &partial);
+        PageOwners taken;
+        PageOwners& own = keep ? keptOwners[pageIndex] : taken;
+        own.owners = bakeTexelOwners(p, &own.partial);
+        const std::vector<uint8_t>& partial = own.partial;
+        const std::vector<int32_t>& owners = own.owners;
         std::vector<std::pair<uint32_t, BakeVertex>>& page = pagePoints[pageIndex];
         for (size_t i = 0; i < owners.size(); ++i) {
             if (!partial[i]) continue;
@@ -400,7 +405,12 @@ void Baker::Impl::coveragePass() {
             parallelFor(pageTexels.size(), [&, first = p](size_t i) {
                 PageTexels& t = pageTexels[i];
                 const int page = first + int(i);
-                t.owners = bakeTexelOwners(page, &t.partial);
+                if (size_t(page) < keptOwners.size()) {  // taken by uploadPartialPoints
+                    t.owners = std::move(keptOwners[size_t(page)].owners);
+                    t.partial = std::move(keptOwners[size_t(page)].partial);
+                } else {
+                    t.owners = bakeTexelOwners(page, &t.partial);
+                }
                 t.footprints = texelFootprints(mesh, page, res, t.owners, charts);
                 curved[size_t(page)] = curvedTexels(mesh, page, res, t.owners, charts, t.partial, t.footprints);
                 t.shared = int64_t(sharedTexels(mesh, page, res, t.owners, charts));
@@ -442,6 +452,7 @@ void Baker::Impl::coveragePass() {
         dilationCodes(codes, res, radius);
         gl::writeTexture(dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, codes.data());
     }
+    keptOwners = {};
     uploadCurvedTexels(curved);
     if (flatInstead > 0)
         logWarning(std::to_string(flatInstead) + " texels whose charts curve within them (or miss their centres) are "

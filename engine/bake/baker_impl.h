@@ -152,6 +152,15 @@ struct Baker::Impl {
     // pageFbo in runs of one page and material, setting `page` and, if asked,
     // the material's uniforms and textures.
     void drawSurface(GLuint program, bool materialUniforms);
+    // The baked texels' owners and partial flags of each page, as the partial
+    // texels' points took them, kept for the coverage pass where all pages' fit
+    // kKeptOwnersBytes (else it takes them again, page by page).
+    struct PageOwners {
+        std::vector<int32_t> owners;
+        std::vector<uint8_t> partial;
+    };
+    static constexpr int64_t kKeptOwnersBytes = int64_t(256) << 20;
+    std::vector<PageOwners> keptOwners;
     void uploadPartialPoints();
     void coveragePass();
     void uploadCurvedTexels(const std::vector<std::vector<CurvedTexel>>& pages);
