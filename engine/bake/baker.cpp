@@ -390,14 +390,17 @@ void Baker::Impl::coveragePass() {
     glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxSsbo);
     int64_t curvedRefs = 0, flatInstead = 0;
     // each page's texels on the CPU (pure functions of the mesh and layout), a
-    // page a core at a time; what follows in page order on this thread
+    // page a core at a time while their transient data stays within 2 GiB (one
+    // 8192^2 page alone: 67 M texels of owners, footprints and cells); what
+    // follows in page order on this thread
     struct PageTexels {
         std::vector<uint8_t> partial;
         std::vector<int32_t> owners;
         std::vector<TexelFootprint> footprints;
         int64_t shared = 0;
     };
-    const int batch = int(std::clamp(std::thread::hardware_concurrency(), 1u, 16u));
+    const int64_t pageBytes = int64_t(res) * res * int64_t(sizeof(int32_t) + 1 + sizeof(TexelFootprint) + sizeof(uint64_t));
+    const int batch = int(std::clamp<int64_t>(std::min<int64_t>(std::thread::hardware_concurrency(), (int64_t(2) << 30) / pageBytes), 1, 16));
     std::vector<PageTexels> pageTexels;
     for (int p = 0; p < layout.pageCount; ++p) {
         if (p % batch == 0) {

@@ -171,13 +171,16 @@ Seams findSeams(const BakeMesh& mesh, int resolution, const SeamOptions& options
     }
     // the part of each texel on its chart, on the pages whose owners the seams needed
     out.texelArea.resize(owners.size());
+    // a page a core while their footprints stay within 2 GiB (one 8192^2 page alone: 3 GiB)
+    const int64_t pageBytes = int64_t(resolution) * resolution * int64_t(sizeof(TexelFootprint) + sizeof(uint64_t));
+    const size_t threads = size_t(std::clamp<int64_t>((int64_t(2) << 30) / pageBytes, 1, 16));
     parallelFor(owners.size(), [&](size_t page) {  // each page its own areas
         if (owners[page].empty()) return;
         const std::vector<TexelFootprint> footprints = texelFootprints(mesh, int(page), resolution, owners[page], chartOf);
         out.texelArea[page].resize(footprints.size());
         for (size_t i = 0; i < footprints.size(); ++i)
             out.texelArea[page][i] = owners[page][i] >= 0 ? footprints[i].area : uint8_t(0);
-    });
+    }, threads);
     return out;
 }
 
