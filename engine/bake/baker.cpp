@@ -390,17 +390,15 @@ void Baker::Impl::coveragePass() {
     glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxSsbo);
     int64_t curvedRefs = 0, flatInstead = 0;
     // each page's texels on the CPU (pure functions of the mesh and layout), a
-    // page a core at a time while their transient data stays within 2 GiB (one
-    // 8192^2 page alone: 67 M texels of owners, footprints and cells); what
-    // follows in page order on this thread
+    // page a core at a time within threadsWithin's memory; what follows in page
+    // order on this thread
     struct PageTexels {
         std::vector<uint8_t> partial;
         std::vector<int32_t> owners;
         std::vector<TexelFootprint> footprints;
         int64_t shared = 0;
     };
-    const int64_t pageBytes = int64_t(res) * res * int64_t(sizeof(int32_t) + 1 + sizeof(TexelFootprint) + sizeof(uint64_t));
-    const int batch = int(std::clamp<int64_t>(std::min<int64_t>(std::thread::hardware_concurrency(), (int64_t(2) << 30) / pageBytes), 1, 16));
+    const int batch = int(threadsWithin(int64_t(res) * res * int64_t(sizeof(int32_t) + 1 + sizeof(TexelFootprint) + sizeof(uint64_t))));
     std::vector<PageTexels> pageTexels;
     for (int p = 0; p < layout.pageCount; ++p) {
         if (p % batch == 0) {
@@ -419,9 +417,10 @@ void Baker::Impl::coveragePass() {
                 t.shared = int64_t(sharedTexels(mesh, page, res, t.owners, charts));
             });
         }
-        const std::vector<uint8_t>& partial = pageTexels[size_t(p % batch)].partial;
-        const std::vector<int32_t>& owners = pageTexels[size_t(p % batch)].owners;
-        const std::vector<TexelFootprint>& footprints = pageTexels[size_t(p % batch)].footprints;
+        const PageTexels& texels = pageTexels[size_t(p % batch)];
+        const std::vector<uint8_t>& partial = texels.partial;
+        const std::vector<int32_t>& owners = texels.owners;
+        const std::vector<TexelFootprint>& footprints = texels.footprints;
         gl::readTexture(dilation.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, codes.data());
         std::erase_if(curved[size_t(p)], [&](const CurvedTexel& c) {
             if (codes[c.texel] != DILATION_SELF) return true;
@@ -441,7 +440,7 @@ void Baker::Impl::coveragePass() {
             ownerCharts[i] = uint16_t(owners[i] < 0 ? TEXEL_CHART_MASK : charts[size_t(owners[i])] & TEXEL_CHART_MASK);
         for (const CurvedTexel& c : curved[size_t(p)]) ownerCharts[c.texel] |= TEXEL_CURVED;
         gl::writeTexture(texelCharts.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_SHORT, 2, ownerCharts.data());
-        stats.sharedTexels += pageTexels[size_t(p % batch)].shared;
+        stats.sharedTexels += texels.shared;
         {
             std::vector<glm::uvec3> packed(footprints.size());
             for (size_t i = 0; i < packed.size(); ++i) {

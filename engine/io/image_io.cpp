@@ -83,8 +83,9 @@ Status checkImage(const ImageRgb& image) {
 // signature and IHDR's 25 bytes), an sRGB chunk (rendering intent 0) for
 // sRGB-encoded values, or gAMA 1.0 for linear ones, so that a reader (this
 // one, readPngTransfer) knows which.
-std::string withTransferChunk(const std::string& png, bool srgb) {
-    if (png.size() < 33) return png;
+std::string withTransferChunk(const std::vector<uint8_t>& png, bool srgb) {
+    std::string out(png.begin(), png.end());
+    if (out.size() < 33) return out;
     const std::string type = srgb ? "sRGB" : "gAMA";
     const std::string data = srgb ? std::string(1, '\0') : std::string("\x00\x01\x86\xa0", 4);  // 100000 = 1.0
     std::string chunk;
@@ -93,7 +94,7 @@ std::string withTransferChunk(const std::string& png, bool srgb) {
     chunk += type + data;
     const uLong crc = crc32(crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(chunk.data() + 4), uInt(chunk.size() - 4));
     for (int k = 3; k >= 0; --k) chunk += char((crc >> (8 * k)) & 0xff);
-    return png.substr(0, 33) + chunk + png.substr(33);
+    return out.insert(33, chunk);
 }
 
 // The transfer function a PNG's chunks before its pixels name: sRGB, or gAMA
@@ -158,7 +159,7 @@ Status writePng8(const std::string& path, const ImageRgb& image, const std::func
     }
     auto encoded = encodePng(bytes.data(), image.width, image.height, 3);
     if (!encoded) return Status::error("cannot write " + path + ": " + encoded.error());
-    return writeFileAtomic(path, withTransferChunk(std::string(encoded->begin(), encoded->end()), srgb));
+    return writeFileAtomic(path, withTransferChunk(*encoded, srgb));
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <string>
 
 // stb in this translation unit only, with static linkage: tinygltf's shared
@@ -110,42 +111,43 @@ bool hdrComplete(const std::vector<uint8_t>& file) {
 Expected<DecodedImage> decodeImageFile(const std::string& path, int64_t maxPixels) {
     using Fail = Expected<DecodedImage>;
     auto reason = [] { return std::string(stbi_failure_reason() ? stbi_failure_reason() : "unknown format"); };
+    // the whole file, read once: the HDR check and the decoder both take it
+    std::ifstream stream(path, std::ios::binary | std::ios::ate);
+    const std::streamoff size = stream ? std::streamoff(stream.tellg()) : -1;
+    if (size < 0) return Fail::failure("cannot open it");
+    if (size > std::numeric_limits<int>::max()) return Fail::failure("larger than 2 GiB");
+    std::vector<uint8_t> bytes(static_cast<size_t>(size));
+    stream.seekg(0);
+    if (!stream.read(reinterpret_cast<char*>(bytes.data()), size)) return Fail::failure("cannot read it");
     // PNG and Radiance HDR only: stb reads more formats, but takes a cut file's
     // missing bytes as 0 in most of them (the HDR is checked for that below)
-    std::ifstream stream(path, std::ios::binary);
-    char magic[10] = {};
-    stream.read(magic, sizeof(magic));
-    const bool png = std::memcmp(magic, "\x89PNG\r\n\x1a\n", 8) == 0;
-    const bool hdr = std::memcmp(magic, "#?RADIANCE", 10) == 0 || std::memcmp(magic, "#?RGBE", 6) == 0;
+    auto startsWith = [&](const char* magic, size_t n) { return bytes.size() >= n && std::memcmp(bytes.data(), magic, n) == 0; };
+    const bool png = startsWith("\x89PNG\r\n\x1a\n", 8);
+    const bool hdr = startsWith("#?RADIANCE", 10) || startsWith("#?RGBE", 6);
     if (!png && !hdr) return Fail::failure("not an EXR, Radiance HDR or PNG file");
+    const stbi_uc* data = bytes.data();
+    const int length = int(bytes.size());
     DecodedImage out;
-    if (!stbi_info(path.c_str(), &out.width, &out.height, &out.channels)) return Fail::failure(reason());
+    if (!stbi_info_from_memory(data, length, &out.width, &out.height, &out.channels)) return Fail::failure(reason());
     if (out.width <= 0 || out.height <= 0 || out.channels <= 0) return Fail::failure("empty image");
     // bounds before allocation: a header may claim any size
     if (int64_t(out.width) * out.height > maxPixels)
         return Fail::failure(std::to_string(out.width) + " x " + std::to_string(out.height) +
                              " is larger than bundlebake reads (" + std::to_string(maxPixels >> 20) + " M pixels)");
-    if (hdr) {
-        stream.clear();
-        stream.seekg(0, std::ios::end);
-        const std::streamoff size = stream.tellg();
-        if (size < 0 || size > (std::streamoff(1) << 32)) return Fail::failure("cannot read its size");
-        std::vector<uint8_t> bytes(static_cast<size_t>(size));
-        stream.seekg(0);
-        if (!stream.read(reinterpret_cast<char*>(bytes.data()), size)) return Fail::failure("cannot read it");
-        if (!hdrComplete(bytes)) return Fail::failure("truncated or malformed Radiance HDR pixel data");
-    }
-    out.isFloat = stbi_is_hdr(path.c_str());
-    const bool is16Bit = !out.isFloat && stbi_is_16_bit(path.c_str());
-    void* raw = out.isFloat ? static_cast<void*>(stbi_loadf(path.c_str(), &out.width, &out.height, &out.channels, 0))
-                : is16Bit   ? static_cast<void*>(stbi_load_16(path.c_str(), &out.width, &out.height, &out.channels, 0))
-                            : static_cast<void*>(stbi_load(path.c_str(), &out.width, &out.height, &out.channels, 0));
+    if (hdr && !hdrComplete(bytes)) return Fail::failure("truncated or malformed Radiance HDR pixel data");
+    out.isFloat = hdr;
+    const bool is16Bit = png && stbi_is_16_bit_from_memory(data, length);
+    int w = 0, h = 0, n = 0;
+    void* raw = hdr       ? static_cast<void*>(stbi_loadf_from_memory(data, length, &w, &h, &n, 0))
+                : is16Bit ? static_cast<void*>(stbi_load_16_from_memory(data, length, &w, &h, &n, 0))
+                          : static_cast<void*>(stbi_load_from_memory(data, length, &w, &h, &n, 0));
     if (!raw) return Fail::failure(reason());
-    out.values.resize(size_t(out.width) * size_t(out.height) * size_t(out.channels));
+    out.width = w, out.height = h, out.channels = n;
+    out.values.resize(size_t(w) * size_t(h) * size_t(n));
     for (size_t i = 0; i < out.values.size(); ++i)
-        out.values[i] = out.isFloat ? static_cast<const float*>(raw)[i]
-                        : is16Bit   ? float(static_cast<const uint16_t*>(raw)[i]) / 65535.0f
-                                    : float(static_cast<const stbi_uc*>(raw)[i]) / 255.0f;
+        out.values[i] = hdr       ? static_cast<const float*>(raw)[i]
+                        : is16Bit ? float(static_cast<const uint16_t*>(raw)[i]) / 65535.0f
+                                  : float(static_cast<const stbi_uc*>(raw)[i]) / 255.0f;
     stbi_image_free(raw);
     return out;
 }

@@ -147,7 +147,6 @@ Seams findSeams(const BakeMesh& mesh, int resolution, const SeamOptions& options
     parallelFor(owners.size(), [&](size_t page) {
         if (seamPage[page]) owners[page] = texelOwners(mesh, int(page), resolution);
     });
-    auto ownerOf = [&](uint32_t page) -> const std::vector<int32_t>& { return owners[page]; };
     for (size_t seam = 0; seam < seamUses.size(); ++seam) {
         const EdgeUse& a = uses[seamUses[seam].first];
         const EdgeUse& b = uses[seamUses[seam].second];
@@ -161,8 +160,8 @@ Seams findSeams(const BakeMesh& mesh, int resolution, const SeamOptions& options
         for (int s = 0; s < n; ++s) {
             const float t = (float(s) + 0.5f) / float(n);
             const glm::vec2 ta = a0 + (a1 - a0) * t, tb = b0 + (b1 - b0) * t;
-            if (!ownLookup(ownerOf(pageA), chartOf, resolution, ta, chartOf[a.triangle]) ||
-                !ownLookup(ownerOf(pageB), chartOf, resolution, tb, chartOf[b.triangle])) {
+            if (!ownLookup(owners[pageA], chartOf, resolution, ta, chartOf[a.triangle]) ||
+                !ownLookup(owners[pageB], chartOf, resolution, tb, chartOf[b.triangle])) {
                 ++out.narrowPairs;
                 continue;
             }
@@ -171,9 +170,7 @@ Seams findSeams(const BakeMesh& mesh, int resolution, const SeamOptions& options
     }
     // the part of each texel on its chart, on the pages whose owners the seams needed
     out.texelArea.resize(owners.size());
-    // a page a core while their footprints stay within 2 GiB (one 8192^2 page alone: 3 GiB)
-    const int64_t pageBytes = int64_t(resolution) * resolution * int64_t(sizeof(TexelFootprint) + sizeof(uint64_t));
-    const size_t threads = size_t(std::clamp<int64_t>((int64_t(2) << 30) / pageBytes, 1, 16));
+    const size_t threads = threadsWithin(int64_t(resolution) * resolution * int64_t(sizeof(TexelFootprint) + sizeof(uint64_t)));
     parallelFor(owners.size(), [&](size_t page) {  // each page its own areas
         if (owners[page].empty()) return;
         const std::vector<TexelFootprint> footprints = texelFootprints(mesh, int(page), resolution, owners[page], chartOf);
