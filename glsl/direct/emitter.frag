@@ -33,6 +33,12 @@ uniform bool emitterDoubleSided;
 uniform vec3 samplePoint;
 uniform int page;
 uniform uint footprintSample;              // this emitter sample's index over all emitters
+// The noise estimate (emitter_noise.comp): the triangle's odd samples' sums
+// apart, at the texels it samples (update.frag's halfAccum, the same places)
+layout(binding = BINDING_EMITTER_ODD_SUMS, rgba32f) uniform coherent image2DArray oddSums;
+uniform bool oddSample;
+uniform int halfStride;
+uniform int supersample;
 layout(binding = BINDING_FOOTPRINT) uniform usampler2DArray footprint;
 const uint NEAR_FIELD_POINTS = 16u;  // F's points a sample within a texel of the emitter's plane
 #include "direct/footprint_point.glsl"
@@ -78,6 +84,13 @@ void main() {
         w = cosX * cosE / (r2 * r2);
         seen = occludedFromLight(x.position, x.plane, samplePoint) ? 0.0 : 1.0;
     }
-    if (fMean > 0.0 || w > 0.0)
-        imageStore(sums, texel.texel, imageLoad(sums, texel.texel) + vec4(fMean, w * seen, w, 0.0));
+    if (fMean > 0.0 || w > 0.0) {
+        vec4 add = vec4(fMean, w * seen, w, 0.0);
+        imageStore(sums, texel.texel, imageLoad(sums, texel.texel) + add);
+        ivec2 outputTexel = texel.texel.xy / supersample;
+        if (oddSample && outputTexel.x % halfStride == 0 && outputTexel.y % halfStride == 0) {
+            ivec3 half_ = ivec3(outputTexel / halfStride * supersample + texel.texel.xy % supersample, texel.texel.z);
+            imageStore(oddSums, half_, imageLoad(oddSums, half_) + add);
+        }
+    }
 }
