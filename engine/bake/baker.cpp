@@ -145,7 +145,7 @@ nlohmann::json BakeStats::toJson() const {
     j["seconds"] = {{"setup", secondsSetup}, {"importance", secondsImportance}, {"tiling", secondsTiling}, {"sun", secondsSun}, {"emitters", secondsEmitters}, {"bundle", secondsBundle}, {"update", secondsUpdate},
                     {"resolve", secondsResolve}, {"combine", secondsCombine}, {"total", secondsTotal()}};
     if (combines > 0) j["combine"] = {{"count", combines}, {"bytes_sent", combineBytes}};
-    j["noise"] = {{"relative", noiseRelative}, {"halves", noiseHalves}, {"emitters", noiseEmitters}, {"lag", noiseLag},
+    j["noise"] = {{"relative", noiseRelative}, {"halves", noiseHalves}, {"direct", noiseDirect}, {"lag", noiseLag},
                   {"sampled_texels", noiseTexels}, {"stride", noiseStride}, {"stopped_at_target", stoppedAtTargetNoise},
                   {"history", noiseHistory}};
     return j;
@@ -187,7 +187,8 @@ Status Baker::Impl::buildPrograms() {
         {&emitterProgram, {"direct/emitter.vert", "direct/emitter.frag"}, ""},
         {&emitterCurvedProgram, {"lightmap/curved.vert", "direct/emitter.frag"}, "#define CURVED_FOOTPRINT 1\n"},
         {&emitterFoldProgram, {"direct/emitter_fold.comp"}, ""},
-        {&emitterNoiseProgram, {"direct/emitter_noise.comp"}, ""},
+        {&emitterNoiseProgram, {"direct/direct_noise.comp"}, ""},
+        {&sunNoiseProgram, {"direct/direct_noise.comp"}, "#define SUN 1\n"},
         {&punctualProgram, {"direct/emitter.vert", "direct/punctual.frag"}, ""},
         {&punctualCurvedProgram, {"lightmap/curved.vert", "direct/punctual.frag"}, "#define CURVED_FOOTPRINT 1\n"},
     };

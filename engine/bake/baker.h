@@ -167,7 +167,7 @@ struct BakeStats {
     // reference, sqrt(noiseHalves^2 + noiseLag^2); < 0: not yet estimated
     double noiseRelative = -1;
     double noiseHalves = 0;           // RMS of the maps' standard deviation over their mean (odd and even halves)
-    double noiseEmitters = 0;         // of which the explicit emitters' light's (their odd and even samples)
+    double noiseDirect = 0;           // of which the direct light's: explicit emitters' and suns' (their odd and even samples)
     double noiseLag = 0;              // RMS of the bounces still to come over the maps' mean (bounceLag)
     int noiseStride = 1;              // every noiseStride-th texel of each axis is sampled
     int64_t noiseTexels = 0;          // sampled texels the last estimate used

@@ -94,9 +94,10 @@ struct Baker::Impl {
     // every stride-th texel of the output layout's, all its half-size texels
     // (update.frag): the estimate is the reduced map's (noise.comp).
     int halfWidth = 1;
-    // the explicit emitters' light's variance per sampled texel of the output
-    // layout (noiseTerms' texels; direct/emitter_noise.comp), or empty
-    std::vector<float> emitterVariance;
+    // the direct light's variance (the explicit emitters' and the suns') per
+    // sampled texel of the output layout (noiseTerms' texels;
+    // direct/direct_noise.comp), or empty
+    std::vector<float> directVariance;
     // texel (x, y)'s place in halfAccum's page, or -1 if it is not sampled
     int64_t halfTexel(int x, int y) const {
         const int k = options.supersample, stride = stats.noiseStride;
@@ -110,7 +111,7 @@ struct Baker::Impl {
     gl::Program updateProgram, sunProgram, updateCurvedProgram, sunCurvedProgram, resolveProgram, rescaleProgram, metaProgram, coverageProgram,
         dilateProgram, readModesProgram, directFoldProgram, distanceProgram, emitterProgram, emitterCurvedProgram,
         emitterFoldProgram, punctualProgram, punctualCurvedProgram,
-        noiseProgram, emitterNoiseProgram;
+        noiseProgram, emitterNoiseProgram, sunNoiseProgram;
     // curved texels (bake/curved_footprints.h): their records, and per cluster its first one
     gl::Buffer curvedTexelBuffer, curvedRefBuffer, curvedTriangleBuffer;
     std::vector<uint32_t> curvedClusterFirst;  // empty: none

@@ -98,6 +98,54 @@ void bindDirectSums(const Baker::Impl& m) {
     glBindImageTexture(BINDING_SCRATCH_B, m.radianceAsFloat.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
 }
 
+// The noise estimate's share of a direct light pass (direct/direct_noise.comp):
+// each light's odd samples' sums at the sampled texels (halfAccum's), and the
+// variance of the pass's light there, added to Baker::Impl::directVariance
+// when the pass ends.
+struct DirectHalves {
+    gl::Texture oddSums, variance;
+    int width = 0;  // sampled texels of the output layout a side
+
+    explicit DirectHalves(const Baker::Impl& m) : width(m.halfWidth / m.options.supersample) {
+        const int pages = m.layout.pageCount;
+        oddSums = gl::Texture::create2DArray("direct light's odd samples' sums", GL_RGBA32F, m.halfWidth, m.halfWidth, pages);
+        variance = gl::Texture::create2DArray("direct light's variance", GL_R32F, width, width, pages);
+        const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+        glClearTexImage(oddSums.id(), 0, GL_RGBA, GL_FLOAT, zero);
+        glClearTexImage(variance.id(), 0, GL_RED, GL_FLOAT, zero);
+        glBindImageTexture(BINDING_DIRECT_ODD_SUMS, oddSums.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
+    }
+
+    // the sampled texels, for the passes that draw the light (their halfStride and supersample)
+    static void setSampling(const Baker::Impl& m, std::initializer_list<const gl::Program*> programs) {
+        for (const gl::Program* p : programs) {
+            glUseProgram(p->id());
+            glUniform1i(p->uniform("halfStride"), m.stats.noiseStride);
+            glUniform1i(p->uniform("supersample"), m.options.supersample);
+        }
+    }
+
+    // One light's variance, its samples all in (`program` in use, its light's uniforms set), its odd sums cleared
+    void addLight(const Baker::Impl& m, const gl::Program& program) const {
+        glUniform1i(program.uniform("halfStride"), m.stats.noiseStride);
+        glUniform1i(program.uniform("supersample"), m.options.supersample);
+        glUniform1i(program.uniform("pageCount"), m.layout.pageCount);
+        glUniform2i(program.uniform("pageSize"), width, width);
+        glBindImageTexture(BINDING_DIRECT_ODD_SUMS, oddSums.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
+        glBindImageTexture(BINDING_DIRECT_VARIANCE, variance.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
+        glBindImageTexture(BINDING_DIRECT_WEIGHTS, m.noiseWeights.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_R16F);
+        glDispatchCompute(GLuint(width + 7) / 8, GLuint(width + 7) / 8, GLuint(m.layout.pageCount));
+        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    }
+
+    void finish(Baker::Impl& m) const {
+        std::vector<float> v(size_t(width) * width * size_t(m.layout.pageCount));
+        gl::readTexture(variance.id(), 0, 0, 0, width, width, m.layout.pageCount, GL_RED, GL_FLOAT, 4, v.data());
+        if (m.directVariance.empty()) m.directVariance.assign(v.size(), 0.0f);
+        for (size_t i = 0; i < v.size(); ++i) m.directVariance[i] += v[i];
+    }
+};
+
 }  // namespace
 
 void Baker::Impl::bakeSun() {
@@ -110,9 +158,13 @@ void Baker::Impl::bakeSun() {
     TilerOptions sunOptions = tilerOptions;
     if (sunPixelSize > 0) sunOptions.fixedPixelSize = sunPixelSize;
     const double jitterUnit = sunPixelSize > 0 ? sunPixelSize : pixelSize;
+    if (lights.empty()) return;
+    const DirectHalves halves(*this);  // each sun's odd jitters apart
+    DirectHalves::setSampling(*this, {&sunProgram, &sunCurvedProgram, &sunLeafRunProgram, &sunCurvedLeafRunProgram});
     for (size_t li = 0; li < lights.size(); ++li) {
         const glm::vec3 irradiance = lights[li].irradiance / radianceUnit;
         uint32_t footprintSample = 0;  // the jitter's index: each one samples another point of every texel's footprint
+        bool oddSample = false;        // the jitter's half for the noise estimate (a checkerboard)
         const BundleTracer::UpdateFn update = [&](const TileFrame& f, uint32_t) {
             const gl::Program& triangles = f.leafRun ? sunLeafRunProgram : sunProgram;
             const gl::Program& curved = f.leafRun ? sunCurvedLeafRunProgram : sunCurvedProgram;
@@ -121,21 +173,37 @@ void Baker::Impl::bakeSun() {
                 glUniform3fv(program->uniform("sunIrradiance"), 1, &irradiance.x);
                 glUniform1f(program->uniform("depthBias"), depthBias);
                 glUniform1ui(program->uniform("footprintSample"), footprintSample);
+                glUniform1i(program->uniform("oddSample"), oddSample);
             }
+            glBindImageTexture(BINDING_DIRECT_ODD_SUMS, halves.oddSums.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
             glBindTextureUnit(BINDING_FOOTPRINT, footprint.id());
             bindDirectSums(*this);
             glBindImageTexture(BINDING_DIRECT, direct.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA16F);
             return BundleTracer::UpdatePrograms{triangles.id(), curvedTexelCount() ? curved.id() : 0u};
         };
+        // The noise estimate's halves are the passes of even and odd index
+        // (every other column where j is even: each half a stratified grid,
+        // its footprint points every other point of the R2 sequence). The
+        // grid is the same for every seed: shifted by a seeded random offset,
+        // pixel centres came within the raster's precision of a blocker's
+        // outline that lies on a texel's edge, and a few texels under it
+        // read 1/4 to 1/2 lit (CutoutBake.SunShadowOfTheMaskIsHalfDark, one
+        // seed in 8).
         for (int jy = 0; jy < j; ++jy)
             for (int jx = 0; jx < j; ++jx) {
                 const glm::vec2 jitter((jx + 0.5f) / j - 0.5f, (jy + 0.5f) / j - 0.5f);
                 footprintSample = uint32_t(jy * j + jx);
+                oddSample = footprintSample % 2 == 1;
                 tracer->run(bundleFrame(glm::normalize(lights[li].direction), jitter, sunOptions.uniform, jitterUnit),
                             sunOptions, uint32_t(li * 1000 + jy * j + jx), false, update, options.leafRuns);
             }
+        glUseProgram(sunNoiseProgram.id());
+        bindDirectSums(*this);
+        glBindImageTexture(BINDING_DIRECT, direct.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
+        halves.addLight(*this, sunNoiseProgram);
         foldDirect(true);  // this sun's mean over its valid samples, added to the direct map
     }
+    halves.finish(*this);
 }
 
 // A face's pixels in front of the plane: the lookups near the plane step up
@@ -272,21 +340,8 @@ void Baker::Impl::bakeEmitters() {
     const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     glClearTexImage(sums.id(), 0, GL_RGBA, GL_FLOAT, zero);
     glBindImageTexture(BINDING_EMITTER_SUMS, sums.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
-    // the noise estimate's: each triangle's odd samples' sums at its sampled
-    // texels, and the variance of the emitters' light there (emitter_noise.comp)
-    const int sampledWidth = halfWidth / options.supersample;
-    gl::Texture oddSums = gl::Texture::create2DArray("emitter odd samples' sums", GL_RGBA32F, halfWidth, halfWidth,
-                                                     layout.pageCount);
-    gl::Texture variance = gl::Texture::create2DArray("emitter light's variance", GL_R32F, sampledWidth, sampledWidth,
-                                                      layout.pageCount);
-    glClearTexImage(oddSums.id(), 0, GL_RGBA, GL_FLOAT, zero);
-    glClearTexImage(variance.id(), 0, GL_RED, GL_FLOAT, zero);
-    glBindImageTexture(BINDING_EMITTER_ODD_SUMS, oddSums.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
-    for (const gl::Program* p : {&emitterProgram, &emitterCurvedProgram}) {
-        glUseProgram(p->id());
-        glUniform1i(p->uniform("halfStride"), stats.noiseStride);
-        glUniform1i(p->uniform("supersample"), options.supersample);
-    }
+    const DirectHalves halves(*this);  // each triangle's samples of odd index apart
+    DirectHalves::setSampling(*this, {&emitterProgram, &emitterCurvedProgram});
 
     for (const Emitter& e : emitters) {
         const BakeVertex* v = &mesh.vertices[e.triangle * 3];
@@ -344,23 +399,14 @@ void Baker::Impl::bakeEmitters() {
         glUniform3fv(emitterNoiseProgram.uniform("emitterRadiance"), 1, &radiance.x);
         glUniform1f(emitterNoiseProgram.uniform("evenCount"), float(e.samples / 2));  // indices 1..n
         glUniform1f(emitterNoiseProgram.uniform("oddCount"), float((e.samples + 1) / 2));
-        glUniform1i(emitterNoiseProgram.uniform("halfStride"), stats.noiseStride);
-        glUniform1i(emitterNoiseProgram.uniform("supersample"), options.supersample);
-        glUniform1i(emitterNoiseProgram.uniform("pageCount"), layout.pageCount);
-        glUniform2i(emitterNoiseProgram.uniform("pageSize"), sampledWidth, sampledWidth);
-        glBindImageTexture(BINDING_EMITTER_VARIANCE, variance.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
-        glBindImageTexture(BINDING_EMITTER_WEIGHTS, noiseWeights.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_R16F);
-        glDispatchCompute(GLuint(sampledWidth + 7) / 8, GLuint(sampledWidth + 7) / 8, GLuint(layout.pageCount));
-        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        halves.addLight(*this, emitterNoiseProgram);
         glUseProgram(emitterFoldProgram.id());
         glUniform3fv(emitterFoldProgram.uniform("emitterRadiance"), 1, &radiance.x);
         glUniform1f(emitterFoldProgram.uniform("sampleCount"), float(e.samples));
         bindDirectSums(*this);
         dispatchPages(emitterFoldProgram.id());
     }
-    emitterVariance.resize(size_t(sampledWidth) * sampledWidth * size_t(layout.pageCount));
-    gl::readTexture(variance.id(), 0, 0, 0, sampledWidth, sampledWidth, layout.pageCount, GL_RED, GL_FLOAT, 4,
-                    emitterVariance.data());
+    halves.finish(*this);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 

@@ -8,12 +8,12 @@
 // seed-to-seed noise; splitting one set by a coin gave 1.4-2.4x, as a random
 // half of a stratified set is noisier than the set); the relative noise is
 // sqrt(mean variance) / mean L_lm over the sampled texels, the measure
-// `bundlebake compare` reports as rel_rmse against a reference. The explicit
-// emitters' light (drawn once, before the bundles: direct_light.cpp) adds its
-// own noise, from its even and odd samples the same way
-// (direct/emitter_noise.comp); it was outside the estimate until 2026-12-05
-// (the Cornell box's estimate read 0.81 of the error at 1024 directions, the
-// shared one's 0.37). Added to it
+// `bundlebake compare` reports as rel_rmse against a reference. The direct
+// light of explicit emitters and suns (drawn once, before the bundles:
+// direct_light.cpp) adds its own noise, from its even and odd samples the
+// same way (direct/direct_noise.comp); it was outside the estimate until
+// 2026-12-05 (the Cornell box's estimate read 0.81 of the error at 1024
+// directions, the shared one's 0.37, mixed_lighting's 0.45). Added to it
 // (in quadrature) is the bounce lag (bounceLag below), the one bias both halves
 // share that the bake's schedule predicts; other biases both share (a source
 // both miss, a texel's mean read where the light bends within it) are not in it.
@@ -162,7 +162,7 @@ void Baker::Impl::estimateNoise() {
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
     std::vector<glm::vec4> values(size_t(width) * width * size_t(layout.pageCount));
     gl::readTexture(noiseTerms.id(), 0, 0, 0, width, width, layout.pageCount, GL_RGBA, GL_FLOAT, 16, values.data());
-    double variance = 0, emitters = 0, sum = 0, bouncedSquares = 0;
+    double variance = 0, direct = 0, sum = 0, bouncedSquares = 0;
     int64_t texels = 0;
     for (size_t i = 0; i < values.size(); ++i) {
         const glm::vec4& v = values[i];
@@ -170,16 +170,16 @@ void Baker::Impl::estimateNoise() {
         sum += v.y;
         texels += v.z > 0.0f;
         bouncedSquares += v.w;
-        if (v.z > 0.0f && i < emitterVariance.size()) emitters += emitterVariance[i];
+        if (v.z > 0.0f && i < directVariance.size()) direct += directVariance[i];
     }
     stats.noiseTexels = texels;
     // too few texels with both halves (the first directions): no estimate yet
     if (texels < 16 || sum <= 0.0) return;
-    // the bundles' and the explicit emitters' (drawn apart: their noises add)
-    variance = variance * noiseHalvesFactor() + emitters;
+    // the bundles' and the direct light's (drawn apart: their noises add)
+    variance = variance * noiseHalvesFactor() + direct;
     const double mean = sum / (3.0 * double(texels));
     stats.noiseHalves = std::sqrt(variance / (3.0 * double(texels))) / mean;
-    stats.noiseEmitters = std::sqrt(emitters / (3.0 * double(texels))) / mean;
+    stats.noiseDirect = std::sqrt(direct / (3.0 * double(texels))) / mean;
     // the lag l scales the bounced light (the bundles' means, RMS b), not the direct light beside it: the
     // bounced light to come is b l / (1 - l), over the mean the maps will have (the furnace: l)
     const double lag = bounceLag(), toCome = std::sqrt(bouncedSquares / (3.0 * double(texels))) * lag / (1.0 - lag);

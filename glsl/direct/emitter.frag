@@ -33,9 +33,9 @@ uniform bool emitterDoubleSided;
 uniform vec3 samplePoint;
 uniform int page;
 uniform uint footprintSample;              // this emitter sample's index over all emitters
-// The noise estimate (emitter_noise.comp): the triangle's odd samples' sums
+// The noise estimate (direct_noise.comp): the triangle's odd samples' sums
 // apart, at the texels it samples (update.frag's halfAccum, the same places)
-layout(binding = BINDING_EMITTER_ODD_SUMS, rgba32f) uniform coherent image2DArray oddSums;
+layout(binding = BINDING_DIRECT_ODD_SUMS, rgba32f) uniform coherent image2DArray oddSums;
 uniform bool oddSample;
 uniform int halfStride;
 uniform int supersample;

@@ -51,6 +51,10 @@ layout(std430, binding = BINDING_NODES) readonly buffer Nodes { Node nodes[]; };
 #include "lib/direct_scratch.glsl"
 layout(binding = BINDING_DIRECT, rgba16f) uniform coherent image2DArray directMap;
 uniform vec3 sunIrradiance;
+// The noise estimate's half (direct/direct_noise.comp SUN): the odd passes'
+// sums and counts at every halfStride-th texel, as halfAccum's
+layout(binding = BINDING_DIRECT_ODD_SUMS, rgba32f) uniform coherent image2DArray oddSums;
+uniform bool oddSample;
 #else
 layout(binding = BINDING_ACCUM, rg32ui) uniform coherent uimage2DArray accum;
 layout(binding = BINDING_ENV) uniform sampler2D envMap;
@@ -63,10 +67,10 @@ uniform uint randomSeed;
 // kept at every halfStride-th texel of each axis.
 layout(binding = BINDING_HALF_ACCUM, rg32ui) uniform coherent uimage2DArray halfAccum;
 uniform bool oddDirection;
-uniform int halfStride;
-uniform int supersample;  // half-size texels a light map texel across (bake/supersample.h): all of a sampled one's
 uniform int backLayerOffset;  // BACK_SIDES: double-sided triangles' back sides' accumulators at layer page + this
 #endif
+uniform int halfStride;
+uniform int supersample;  // half-size texels a light map texel across (bake/supersample.h): all of a sampled one's
 uniform uint nodeCount;      // nodes in this tile's lists (END_OF_LIST is larger)
 uniform float depthBias;      // scene units: float precision floor
 uniform uint footprintSample; // this pass's sample of each texel's footprint (the direction's, the sun jitter's index)
@@ -517,9 +521,15 @@ void main() {
 
 #ifdef SUN_PASS
     // a valid sample: sums += lit irradiance * cos / pi, count += 1 (exact in fp16 to 2048)
-    addDirect(texel, lit && bestNode == END_OF_LIST ? sunIrradiance * cosine / PI : vec3(0.0));
+    vec3 sunLight = lit && bestNode == END_OF_LIST ? sunIrradiance * cosine / PI : vec3(0.0);
+    addDirect(texel, sunLight);
     vec4 d = imageLoad(directMap, texel);
     imageStore(directMap, texel, vec4(d.rgb, d.a + 1.0));
+    ivec2 outputTexel = texel.xy / supersample;
+    if (oddSample && outputTexel.x % halfStride == 0 && outputTexel.y % halfStride == 0) {
+        ivec3 half_ = ivec3(outputTexel / halfStride * supersample + texel.xy % supersample, texel.z);
+        imageStore(oddSums, half_, imageLoad(oddSums, half_) + vec4(sunLight, 1.0));
+    }
 #else
     vec3 incoming = incomingRadiance(bestNode, seenSide, ahead ? bundleDir : -bundleDir);
     // the running cosine-weighted mean of L_in (rgb) and its weight W (a)

@@ -58,10 +58,10 @@ struct LeafRecord {
 #define BINDING_HALF_ACCUM 3     // image unit: rg32ui odd directions' accumulators at every halfStride-th texel
 #define BINDING_NOISE_WEIGHTS 5  // image unit, noise pass only: r16f each sampled texel's half-size texels' weights
                                  // (the noise estimate; unit 3 is the direct-light scratch only while that is baked)
-#define BINDING_EMITTER_ODD_SUMS 6  // image unit, emitter passes only: rgba32f an emitter triangle's odd samples'
-                                    // sums at the noise estimate's sampled texels (halfAccum's size)
-#define BINDING_EMITTER_VARIANCE 7  // image unit, emitter passes only: r32f the emitters' variance per sampled texel
-#define BINDING_EMITTER_WEIGHTS 1   // image unit, emitter noise pass only: noise weights (BINDING_NOISE_WEIGHTS')
+#define BINDING_DIRECT_ODD_SUMS 6  // image unit, direct light passes only: rgba32f an emitter triangle's or a sun's
+                                   // odd samples' sums at the noise estimate's sampled texels (halfAccum's size)
+#define BINDING_DIRECT_VARIANCE 7  // image unit, direct light passes only: r32f its light's variance per sampled texel
+#define BINDING_DIRECT_WEIGHTS 1   // image unit, direct noise pass only: the noise weights (BINDING_NOISE_WEIGHTS')
 #define BINDING_RADIANCE 0       // texture unit: RGB9_E5 outgoing radiance Lo per texel, array of pages
 #define BINDING_ENV 1            // texture unit: environment map (equirectangular)
 #define BINDING_MATERIAL_TEX 2   // texture unit: a material's albedo texture (emission: + 1)

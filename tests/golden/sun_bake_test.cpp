@@ -308,5 +308,37 @@ TEST(SunBake, BoxCastsShadowWhereGeometrySays) {
                 a.texels);
 }
 
+// The sun's light is drawn once, before the bundles, from its j x j jittered
+// passes, and the noise estimate holds its error from the passes of even and
+// odd index (direct/direct_noise.comp SUN). On the black box's shadow (the
+// bundles carry nothing) with 4 x 4 passes the estimate must lie within 1.5x
+// of the error against a 4096-spp reference (whose own noise is about 0.2 %
+// of the mean, from the penumbra's texels). Without the sun's term the
+// estimate read 0. (The sun's passes are the same for every seed, so the
+// error is checked against the reference, not against a second seed.)
+TEST(SunBake, NoiseEstimateHoldsTheSunsError) {
+    BB_REQUIRE_GL();
+    Scene scene = groundScene();
+    addBox(scene, glm::vec3(0.0f, 1.0f, 0.0f), glm::vec3(0.4f), 0, true, "cube");
+    scene.lights.push_back({"sun", sunDirection(40.0, 25.0), glm::vec3(3.0f, 2.0f, 1.0f)});
+    auto layout = packLayout(scene, 128, 16.0f);
+    ASSERT_TRUE(layout) << layout.error();
+    ReferenceOptions ro;
+    ro.spp = 4096;
+    auto cpu = bakeReference(scene, *layout, ro);
+    ASSERT_TRUE(cpu) << cpu.error();
+    BakeOptions bo = blackOptions();
+    bo.directions = 16;
+    bo.sunJitter = 4;
+    BakeStats stats;
+    auto gpu = bakeGpu(scene, *layout, bo, nullptr, &stats);
+    ASSERT_TRUE(gpu) << gpu.error();
+    const double error = compareMaps(*gpu, *cpu).relativeRmse();
+    std::printf("[sun] 4 x 4 passes: error %.4f against the reference, estimate %.4f (direct %.4f)\n", error,
+                stats.noiseRelative, stats.noiseDirect);
+    EXPECT_GE(stats.noiseRelative, error / 1.5) << "the estimate is too low";
+    EXPECT_LE(stats.noiseRelative, error * 1.5) << "the estimate is too high";
+}
+
 }  // namespace
 }  // namespace bb::test
