@@ -164,7 +164,7 @@ void Baker::Impl::bakeSun() {
     for (size_t li = 0; li < lights.size(); ++li) {
         const glm::vec3 irradiance = lights[li].irradiance / radianceUnit;
         uint32_t footprintSample = 0;  // the jitter's index: each one samples another point of every texel's footprint
-        bool oddSample = false;        // the jitter's half for the noise estimate (a checkerboard)
+        bool oddSample = false;        // the pass's half for the noise estimate (below)
         const BundleTracer::UpdateFn update = [&](const TileFrame& f, uint32_t) {
             const gl::Program& triangles = f.leafRun ? sunLeafRunProgram : sunProgram;
             const gl::Program& curved = f.leafRun ? sunCurvedLeafRunProgram : sunCurvedProgram;
