@@ -39,6 +39,7 @@ layout(binding = BINDING_DIRECT_ODD_SUMS, rgba32f) uniform coherent image2DArray
 uniform bool oddSample;
 uniform int halfStride;
 uniform int supersample;
+#include "lib/noise_half.glsl"
 layout(binding = BINDING_FOOTPRINT) uniform usampler2DArray footprint;
 const uint NEAR_FIELD_POINTS = 16u;  // F's points a sample within a texel of the emitter's plane
 #include "direct/footprint_point.glsl"
@@ -87,9 +88,8 @@ void main() {
     if (fMean > 0.0 || w > 0.0) {
         vec4 add = vec4(fMean, w * seen, w, 0.0);
         imageStore(sums, texel.texel, imageLoad(sums, texel.texel) + add);
-        ivec2 outputTexel = texel.texel.xy / supersample;
-        if (oddSample && outputTexel.x % halfStride == 0 && outputTexel.y % halfStride == 0) {
-            ivec3 half_ = ivec3(outputTexel / halfStride * supersample + texel.texel.xy % supersample, texel.texel.z);
+        ivec3 half_;
+        if (oddSample && noiseHalfTexel(texel.texel, half_)) {
             imageStore(oddSums, half_, imageLoad(oddSums, half_) + add);
         }
     }

@@ -71,6 +71,7 @@ uniform int backLayerOffset;  // BACK_SIDES: double-sided triangles' back sides'
 #endif
 uniform int halfStride;
 uniform int supersample;  // half-size texels a light map texel across (bake/supersample.h): all of a sampled one's
+#include "lib/noise_half.glsl"
 uniform uint nodeCount;      // nodes in this tile's lists (END_OF_LIST is larger)
 uniform float depthBias;      // scene units: float precision floor
 uniform uint footprintSample; // this pass's sample of each texel's footprint (the direction's, the sun jitter's index)
@@ -525,9 +526,8 @@ void main() {
     addDirect(texel, sunLight);
     vec4 d = imageLoad(directMap, texel);
     imageStore(directMap, texel, vec4(d.rgb, d.a + 1.0));
-    ivec2 outputTexel = texel.xy / supersample;
-    if (oddSample && outputTexel.x % halfStride == 0 && outputTexel.y % halfStride == 0) {
-        ivec3 half_ = ivec3(outputTexel / halfStride * supersample + texel.xy % supersample, texel.z);
+    ivec3 half_;
+    if (oddSample && noiseHalfTexel(texel, half_)) {
         imageStore(oddSums, half_, imageLoad(oddSums, half_) + vec4(sunLight, 1.0));
     }
 #else
@@ -549,9 +549,8 @@ void main() {
         imageStore(accum, back, uvec4(folded, 0u, 0u));
     }
 #endif
-    ivec2 outputTexel = texel.xy / supersample;
-    if (oddDirection && outputTexel.x % halfStride == 0 && outputTexel.y % halfStride == 0) {
-        ivec3 half_ = ivec3(outputTexel / halfStride * supersample + texel.xy % supersample, texel.z);
+    ivec3 half_;
+    if (oddDirection && noiseHalfTexel(texel, half_)) {
         imageStore(halfAccum, half_, uvec4(foldSample(imageLoad(halfAccum, half_).rg, incoming, w, pcgHash(h ^ 0x9e3779b9u)), 0u, 0u));
     }
 #endif
