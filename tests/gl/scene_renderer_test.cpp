@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "gl/gl.h"
@@ -66,7 +68,9 @@ int cpuToneMapped(float radiance, float exposure) {
     io::ImageRgb one;
     one.width = one.height = 1;
     one.pixels = {glm::vec3(radiance)};
-    const std::string path = testing::TempDir() + "/tonemap_probe.png";
+    // one file per process: ctest runs these tests side by side, and one's
+    // remove took the other's probe before it was read (a clean-clone run)
+    const std::string path = testing::TempDir() + "/tonemap_probe_" + std::to_string(::getpid()) + ".png";
     EXPECT_TRUE(io::writePngToneMapped(path, one, exposure));
     auto back = readImage8(path);
     EXPECT_TRUE(back) << back.error();
