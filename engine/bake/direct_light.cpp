@@ -127,8 +127,7 @@ struct DirectHalves {
 
     // One light's variance, its samples all in (`program` in use, its light's uniforms set), its odd sums cleared
     void addLight(const Baker::Impl& m, const gl::Program& program) const {
-        glUniform1i(program.uniform("halfStride"), m.stats.noiseStride);
-        glUniform1i(program.uniform("supersample"), m.options.supersample);
+        setSampling(m, {&program});
         glUniform1i(program.uniform("pageCount"), m.layout.pageCount);
         glUniform2i(program.uniform("pageSize"), width, width);
         glBindImageTexture(BINDING_DIRECT_ODD_SUMS, oddSums.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
@@ -363,9 +362,8 @@ void Baker::Impl::bakeEmitters() {
         std::vector<std::pair<uint64_t, int>> order(size_t(e.samples));
         for (int i = 0; i < e.samples; ++i) order[size_t(i)] = {hash(options.seed, e.triangle, uint64_t(i)), i};
         std::sort(order.begin(), order.end());
-        const auto unit = [](uint64_t h) { return double(h >> 11) * 0x1.0p-53; };
-        const double shiftU = unit(hash(options.seed, e.triangle, 0x5368696674ull)),
-                     shiftV = unit(hash(options.seed, e.triangle, 0x5368696675ull));
+        const double shiftU = unitFromHash(hash(options.seed, e.triangle, 0x5368696674ull)),
+                     shiftV = unitFromHash(hash(options.seed, e.triangle, 0x5368696675ull));
         for (int i = 0; i < e.samples; ++i) {
             const int k = order[size_t(i)].second + 1;
             double su = std::fmod(shiftU + 0.7548776662466927 * k, 1.0);

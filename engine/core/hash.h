@@ -14,6 +14,8 @@ inline uint64_t mix64(uint64_t x) {
 }
 inline uint64_t hash(uint64_t a, uint64_t b) { return mix64(a ^ mix64(b)); }
 inline uint64_t hash(uint64_t a, uint64_t b, uint64_t c) { return hash(hash(a, b), c); }
+// [0, 1) with 53 bits from a hash's high bits
+inline double unitFromHash(uint64_t h) { return double(h >> 11) * 0x1.0p-53; }
 
 // splitmix64 (Steele, Lea, Flood 2014): a small seeded stream.
 struct SplitMix64 {
@@ -24,7 +26,7 @@ struct SplitMix64 {
         return z;
     }
     // [0, 1) with 53 bits
-    double uniform() { return double(next() >> 11) * 0x1.0p-53; }
+    double uniform() { return unitFromHash(next()); }
     // [0, 1) with 24 bits (a float's, never rounded up to 1)
     float uniformFloat() { return float(next() >> 40) * 0x1.0p-24f; }
 };
