@@ -137,7 +137,8 @@ nlohmann::json BakeStats::toJson() const {
                    {"exact_footprint_texels", exactFootprintTexels}, {"supersample", supersample},
                    {"supersample_filled_texels", supersampleFilledTexels},
                    {"supersample_lost_texels", supersampleLostTexels}};
-    j["direct_light"] = {{"explicit_emitters", explicitEmitters}, {"emitter_samples", emitterSampleCount}};
+    j["direct_light"] = {{"explicit_emitters", explicitEmitters}, {"emitter_samples", emitterSampleCount},
+                         {"sun_passes_per_axis", sunJitter}};
     double bundleSeconds = secondsBundle > 0 ? secondsBundle : 1e-9;
     double updateSeconds = secondsUpdate > 0 ? secondsUpdate : 1e-9;
     j["throughput"] = {{"fragments", fragments}, {"fragments_per_second_bundle_pass", fragments / bundleSeconds},

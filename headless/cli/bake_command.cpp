@@ -75,6 +75,10 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
                    "Visibility samples over all explicit emitters (0 = max(128, directions / 4))")
         ->check(CLI::Range(0, 1 << 16))
         ->capture_default_str();
+    cmd.add_option("--sun-jitter", a.sunJitter,
+                   "Sun passes per axis, each at another point of every texel's footprint (0 = from the directions)")
+        ->check(CLI::Range(0, 64))
+        ->capture_default_str();
     addSupersampleOption(cmd, a.supersample);
     cmd.add_option("--target-noise", a.targetNoise,
                    "Stop once the light maps' estimated relative error (their noise and the bounces still to come) is "
@@ -156,6 +160,7 @@ int runBake(const BakeArgs& args) {
                         : args.direct == "bundles"  ? BakeOptions::DirectLight::Bundles
                                                     : BakeOptions::DirectLight::Auto;
     options.emitterSamples = args.emitterSamples;
+    options.sunJitter = args.sunJitter;
     options.share = mpi;
     options.targetNoise = args.targetNoise;
     options.supersample = supersampleValue(args.supersample);
@@ -229,6 +234,7 @@ int runBake(const BakeArgs& args) {
                      {"texel_density", args.scene.texelDensity}, {"history_power", (*baker)->stats().historyPower},
                      {"history_plateau", (*baker)->stats().historyPlateau},
                      {"direct", args.direct}, {"emitter_samples", args.emitterSamples},
+                     {"sun_jitter", args.sunJitter},
                      {"seams", args.seams}, {"supersample", args.supersample}, {"mpi_ranks", mpi ? mpi->count() : 1}, {"target_noise", args.targetNoise}};
     info.wallSeconds = seconds;
     info.writePreviews = args.preview;

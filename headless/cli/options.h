@@ -50,6 +50,7 @@ struct BakeArgs {
     int historyPlateau = 0;
     std::string direct = "auto";
     int emitterSamples = 0;
+    int sunJitter = 0;
     std::string supersample = "auto";  // auto | 1 | 2 | 4 (BakeOptions::supersample)
     std::string seams = "stitch";     // stitch | off (bake/seam_stitch.h)
     bool preview = true;
