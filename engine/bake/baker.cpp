@@ -15,6 +15,7 @@
 #include "bake/transport_albedo.h"
 #include "bake/directions.h"
 #include "core/check.h"
+#include "core/hash.h"
 #include "core/log.h"
 #include "core/memory.h"
 #include "core/parallel.h"
@@ -157,8 +158,21 @@ double defaultHistoryPower(double transportAlbedo) {
     return std::clamp(std::round(2.0 * rho / std::pow(1.0 - rho, 1.5)), 1.0, 1024.0);
 }
 
+// A Cranley-Patterson rotation of the footprint points' R2 sequence, the same
+// for every texel (layouts of one density still bake the same values) and new
+// with each seed, so that two seeds' bakes differ by all of a bake's sampling
+// and not by all of it less the footprint's (a sun's shadow edge: by a third
+// of the error with the points fixed, design notes "The direct light's noise
+// in the estimate").
+std::string Baker::Impl::footprintShiftDefine() const {
+    const uint64_t h = hash(options.seed, 0x466f6f747072696eull);
+    return "#define FOOTPRINT_SHIFT uvec2(" + std::to_string(uint32_t(h)) + "u, " + std::to_string(uint32_t(h >> 32)) +
+           "u)\n";
+}
+
 Status Baker::Impl::buildPrograms() {
-    const std::string rounding = roundingDefine();
+    const std::string shift = footprintShiftDefine();
+    const std::string rounding = roundingDefine() + shift;
     struct Spec {
         gl::Program* target;
         std::vector<std::string> files;
@@ -169,13 +183,13 @@ Status Baker::Impl::buildPrograms() {
          rounding + backSidesDefine() + "#define LEAF_TABLE 1\n"},
         {&updateCurvedLeafRunProgram, {"lightmap/curved.vert", "lightmap/update.frag"},
          rounding + backSidesDefine() + "#define CURVED_FOOTPRINT 1\n#define LEAF_TABLE 1\n"},
-        {&sunProgram, {"lightmap/update.vert", "lightmap/update.frag"}, "#define SUN_PASS 1\n"},
+        {&sunProgram, {"lightmap/update.vert", "lightmap/update.frag"}, shift + "#define SUN_PASS 1\n"},
         {&updateCurvedProgram, {"lightmap/curved.vert", "lightmap/update.frag"},
          rounding + backSidesDefine() + "#define CURVED_FOOTPRINT 1\n"},
-        {&sunCurvedProgram, {"lightmap/curved.vert", "lightmap/update.frag"}, "#define SUN_PASS 1\n#define CURVED_FOOTPRINT 1\n"},
-        {&sunLeafRunProgram, {"lightmap/update.vert", "lightmap/update.frag"}, "#define SUN_PASS 1\n#define LEAF_TABLE 1\n"},
+        {&sunCurvedProgram, {"lightmap/curved.vert", "lightmap/update.frag"}, shift + "#define SUN_PASS 1\n#define CURVED_FOOTPRINT 1\n"},
+        {&sunLeafRunProgram, {"lightmap/update.vert", "lightmap/update.frag"}, shift + "#define SUN_PASS 1\n#define LEAF_TABLE 1\n"},
         {&sunCurvedLeafRunProgram, {"lightmap/curved.vert", "lightmap/update.frag"},
-         "#define SUN_PASS 1\n#define CURVED_FOOTPRINT 1\n#define LEAF_TABLE 1\n"},
+         shift + "#define SUN_PASS 1\n#define CURVED_FOOTPRINT 1\n#define LEAF_TABLE 1\n"},
         {&resolveProgram, {"lightmap/resolve.comp"}, ""},
         {&rescaleProgram, {"lightmap/rescale.comp"}, rounding},
         {&noiseProgram, {"lightmap/noise.comp"}, ""},
@@ -185,13 +199,13 @@ Status Baker::Impl::buildPrograms() {
         {&readModesProgram, {"lightmap/read_modes.comp"}, ""},
         {&directFoldProgram, {"lightmap/direct_fold.comp"}, rounding},
         {&distanceProgram, {"direct/distance.vert", "direct/distance.frag"}, ""},
-        {&emitterProgram, {"direct/emitter.vert", "direct/emitter.frag"}, ""},
-        {&emitterCurvedProgram, {"lightmap/curved.vert", "direct/emitter.frag"}, "#define CURVED_FOOTPRINT 1\n"},
+        {&emitterProgram, {"direct/emitter.vert", "direct/emitter.frag"}, shift},
+        {&emitterCurvedProgram, {"lightmap/curved.vert", "direct/emitter.frag"}, shift + "#define CURVED_FOOTPRINT 1\n"},
         {&emitterFoldProgram, {"direct/emitter_fold.comp"}, ""},
         {&emitterNoiseProgram, {"direct/direct_noise.comp"}, ""},
         {&sunNoiseProgram, {"direct/direct_noise.comp"}, "#define SUN 1\n"},
-        {&punctualProgram, {"direct/emitter.vert", "direct/punctual.frag"}, ""},
-        {&punctualCurvedProgram, {"lightmap/curved.vert", "direct/punctual.frag"}, "#define CURVED_FOOTPRINT 1\n"},
+        {&punctualProgram, {"direct/emitter.vert", "direct/punctual.frag"}, shift},
+        {&punctualCurvedProgram, {"lightmap/curved.vert", "direct/punctual.frag"}, shift + "#define CURVED_FOOTPRINT 1\n"},
     };
     for (auto& s : specs) {
         auto p = gl::buildProgram(s.files, s.defines);

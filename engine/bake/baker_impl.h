@@ -83,6 +83,8 @@ struct Baker::Impl {
     std::string roundingDefine() const {
         return options.rounding == Rounding::Nearest ? "#define ROUNDING_NEAREST 1\n" : "";
     }
+    // The seed's shift of every texel's footprint points (lib/texel_footprint.glsl FOOTPRINT_SHIFT)
+    std::string footprintShiftDefine() const;
     gl::Texture accumAsFloat, radianceBits, radianceAsFloat;  // views: rg32f, r32ui, r32f
     gl::Texture resolved;  // the whole light map L_lm, made on first use (the viewer's)
     // the noise estimate (noise.cpp): the odd directions' accumulators at every

@@ -9,14 +9,20 @@
 // smooth); past a chart border (TRIANGLE_CHART_BORDER0 << k) the point is off
 // the surface and is drawn again.
 //
-// Sample i of a texel: point i of the R2 sequence (Roberts 2018), the same for
-// every texel, so that any run of consecutive samples is spread evenly over
-// the square, and a texel's samples depend on where it lies on its surface,
-// not on where its chart lies in the atlas (layouts of one density bake the
-// same values). Candidates off the chart are replaced by hashed ones (uniform
+// Sample i of a texel: point i of the R2 sequence (Roberts 2018), shifted by
+// the seed (FOOTPRINT_SHIFT below), the same for every texel, so that any run
+// of consecutive samples is spread evenly over the square, and a texel's
+// samples depend on where it lies on its surface, not on where its chart lies
+// in the atlas (layouts of one density bake the same values). Candidates off the chart are replaced by hashed ones (uniform
 // over the part on the chart, as rejection sampling is); after 8 the centre.
 //
 // Needs lib/rounding.glsl (pcgHash, uniform01) and shared/mesh_layout.h.
+
+// The seed's shift of the R2 sequence (a Cranley-Patterson rotation, the same
+// for every texel: Baker::Impl::footprintShiftDefine), and of the hashed candidates
+#ifndef FOOTPRINT_SHIFT
+#define FOOTPRINT_SHIFT uvec2(0u)
+#endif
 
 // A texel's frame along its triangle's plane, at its centre: what the light
 // map raster gives a fragment (its varyings and their screen derivatives, one
@@ -91,10 +97,10 @@ bool offChart(vec3 bary, vec3 baryDx, vec3 baryDy, uint flags, uvec3 footprint, 
 vec2 footprintCandidate(uint sampleIndex, int attempt, uvec2 cells) {
     if (attempt == 0) {
         // R2 in 32-bit fixed point (alpha * 2^32, wrapping: exact for any index), from 0.5
-        uvec2 fixedPoint = uvec2(sampleIndex * 3242174889u, sampleIndex * 2447445413u) + 0x80000000u;
+        uvec2 fixedPoint = uvec2(sampleIndex * 3242174889u, sampleIndex * 2447445413u) + 0x80000000u + FOOTPRINT_SHIFT;
         return vec2(fixedPoint >> 8u) * (1.0 / 16777216.0) - 0.5;
     }
-    uint h = pcgHash(sampleIndex * 8u + uint(attempt - 1)), h1 = pcgHash(h), h2 = pcgHash(h1);
+    uint h = pcgHash((sampleIndex * 8u + uint(attempt - 1)) ^ FOOTPRINT_SHIFT.x), h1 = pcgHash(h), h2 = pcgHash(h1);
     uint low = uint(bitCount(cells.x)), count = low + uint(bitCount(cells.y));
     if (count == 0u) return vec2(uniform01(h), uniform01(h1)) - 0.5;
     // the k-th cell on the chart, k uniform

@@ -113,12 +113,14 @@ void expectRowMeans(const LightmapPages& maps, const char* what, double toleranc
 }
 
 // The sun pass: 256 points of each texel's footprint (sunJitter 16), the same
-// R2 points in every texel, so the row shares one quadrature error (+0.07 %
-// for max(0, cos) over the turn). Measured: every texel within 0.06 % (-0.05 %
-// in red); exactly 0 before curved texels, and +4.9 % while samples whose
-// pixel found no crossing of their facet were skipped (the facets the sun
-// grazes, between the lit and dark halves). Tolerance: every texel within 1 %
-// of E / pi^2.
+// R2 points in every texel, so the row shares one quadrature error (max(0,
+// cos) over the turn: +0.07 % with the points unshifted; since they are
+// shifted by the seed, -1.2 / +0.7 / 0.0 / +0.3 / -0.6 / +0.1 / +0.1 / -0.6 %
+// with seeds 1-8, mean -0.14 %). Measured before the shift: every texel within
+// 0.06 %; exactly 0 before curved texels, and +4.9 % while samples whose pixel
+// found no crossing of their facet were skipped (the facets the sun grazes,
+// between the lit and dark halves). Tolerance: the mean of seeds 1-4's bakes,
+// every texel within 1 % of E / pi^2.
 TEST(CurvedFootprintBake, TubeUnderAnOverheadSunReadsItsTurnsMean) {
     BB_REQUIRE_GL();
     Scene scene = tubeScene();
@@ -131,6 +133,13 @@ TEST(CurvedFootprintBake, TubeUnderAnOverheadSunReadsItsTurnsMean) {
     auto maps = bakeTube(scene, options, &stats);
     ASSERT_TRUE(maps) << maps.error();
     EXPECT_GE(stats.curvedTexels, 24) << "the tube's row must be found curved";
+    for (int seed = 2; seed <= 4; ++seed) {
+        options.seed = seed;
+        auto more = bakeTube(scene, options, nullptr);
+        ASSERT_TRUE(more) << more.error();
+        for (size_t i = 0; i < maps->pages[0].pixels.size(); ++i) maps->pages[0].pixels[i] += more->pages[0].pixels[i];
+    }
+    for (auto& v : maps->pages[0].pixels) v /= 4.0f;
     for (int c = 0; c < 3; ++c) {
         const double expected = irradiance[c] / (PI * PI);
         const Summary s = tubeRow(*maps, c);

@@ -163,8 +163,10 @@ TEST(DirectLightFootprint, FanTriangulatedFloorsCornersMatchTheReference) {
 // that see the ceiling at a grazing angle read it as their own shadow. Now
 // (16 points a sample within a texel of the emitter's plane, the shallower
 // cube texel where the nearest one's ray meets the ceiling short of the
-// point): the mean within 0.01 %, the worst 0.6 %, inside 0.1 %. Tolerances:
-// each outline texel 1 %, their mean 0.3 %, inside 0.5 %.
+// point): the mean within 0.01 %, the worst 0.6 %, inside 0.1 %. Since the
+// footprint points are shifted by the seed (2026-12-06), seeds 1-6: the mean
+// within 0.21 %, the worst 0.44-1.08 %, inside 0.15-0.45 %. Tolerances: each
+// outline texel 1.5 %, their mean 0.3 %, inside 0.5 %.
 TEST(DirectLightFootprint, CeilingJustOverAnEmitterHoldsItsOutlinesShare) {
     BB_REQUIRE_GL();
     const double gap = 1.0 / 256.0, emitterHalf = 0.53;  // 16 texels a unit: the outline crosses texels at 48 %
@@ -193,7 +195,7 @@ TEST(DirectLightFootprint, CeilingJustOverAnEmitterHoldsItsOutlinesShare) {
         }
         const double got = maps->pages[size_t(page)].pixels[i].g;
         if (f > 0.05 && f < 0.95) {
-            EXPECT_NEAR(got / f, 1.0, 0.01) << "outline texel " << a << ", " << b << ": " << got << " against " << f;
+            EXPECT_NEAR(got / f, 1.0, 0.015) << "outline texel " << a << ", " << b << ": " << got << " against " << f;
             outlineSum += got;
             outlineExpected += f;
             worst = std::max(worst, std::fabs(got / f - 1.0));
