@@ -326,7 +326,9 @@ bool planeSample(FlatFrame f, ivec3 texel, vec3 leafPoint, out TexelSample s) {
     if (!takeLeaf(rootFromBundle(bundleFromWorld(leafPoint).xy))) return false;
     vec2 centreRoot = rootFromBundle(bundleFromWorld(f.position).xy);
 #ifdef SUN_PASS
-    uint pixelSeed = pcgHash(footprintSample + 0x632be5abu);
+    // which of the pixel centres in the footprint: another with each seed (the
+    // sun's grid is the same for every seed, bakeSun)
+    uint pixelSeed = pcgHash((footprintSample + 0x632be5abu) ^ FOOTPRINT_SHIFT.y);
 #else
     uint pixelSeed = pcgHash(randomSeed);
 #endif
