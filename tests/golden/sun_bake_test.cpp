@@ -324,23 +324,37 @@ Scene boxShadowScene() {
     return scene;
 }
 
+// The box's shadow laid out and baked by the reference at `spp`.
+struct BoxShadow {
+    Scene scene = boxShadowScene();
+    Layout layout;
+    LightmapPages reference;
+};
+Expected<BoxShadow> boxShadow(int spp) {
+    BoxShadow b;
+    auto layout = packLayout(b.scene, 128, 16.0f);
+    if (!layout) return Expected<BoxShadow>::failure(layout.error());
+    b.layout = std::move(*layout);
+    ReferenceOptions ro;
+    ro.spp = spp;
+    auto cpu = bakeReference(b.scene, b.layout, ro);
+    if (!cpu) return Expected<BoxShadow>::failure(cpu.error());
+    b.reference = std::move(*cpu);
+    return b;
+}
+
 TEST(SunBake, NoiseEstimateHoldsTheSunsError) {
     BB_REQUIRE_GL();
-    const Scene scene = boxShadowScene();
-    auto layout = packLayout(scene, 128, 16.0f);
-    ASSERT_TRUE(layout) << layout.error();
-    ReferenceOptions ro;
-    ro.spp = 4096;
-    auto cpu = bakeReference(scene, *layout, ro);
-    ASSERT_TRUE(cpu) << cpu.error();
+    auto box = boxShadow(4096);
+    ASSERT_TRUE(box) << box.error();
     BakeOptions bo = blackOptions();
     bo.directions = 16;
     bo.sunJitter = 4;
     BakeStats stats;
-    auto gpu = bakeGpu(scene, *layout, bo, nullptr, &stats);
+    auto gpu = bakeGpu(box->scene, box->layout, bo, nullptr, &stats);
     ASSERT_TRUE(gpu) << gpu.error();
     EXPECT_EQ(stats.sunJitter, 4);
-    const double error = compareMaps(*gpu, *cpu).relativeRmse();
+    const double error = compareMaps(*gpu, box->reference).relativeRmse();
     std::printf("[sun] 4 x 4 passes: error %.4f against the reference, estimate %.4f (direct %.4f)\n", error,
                 stats.noiseRelative, stats.noiseDirect);
     EXPECT_GE(stats.noiseRelative, error / 1.5) << "the estimate is too low";
@@ -355,21 +369,16 @@ TEST(SunBake, NoiseEstimateHoldsTheSunsError) {
 // 4096-spp reference (4 x 4 passes); now 0.0131 against 0.0155.
 TEST(SunBake, TwoSeedsDifferByTheSunsError) {
     BB_REQUIRE_GL();
-    const Scene scene = boxShadowScene();
-    auto layout = packLayout(scene, 128, 16.0f);
-    ASSERT_TRUE(layout) << layout.error();
-    ReferenceOptions ro;
-    ro.spp = 4096;
-    auto cpu = bakeReference(scene, *layout, ro);
-    ASSERT_TRUE(cpu) << cpu.error();
+    auto box = boxShadow(4096);
+    ASSERT_TRUE(box) << box.error();
     BakeOptions bo = blackOptions();
     bo.sunJitter = 4;
-    auto first = bakeGpu(scene, *layout, bo);
+    auto first = bakeGpu(box->scene, box->layout, bo);
     ASSERT_TRUE(first) << first.error();
     bo.seed = 2;
-    auto second = bakeGpu(scene, *layout, bo);
+    auto second = bakeGpu(box->scene, box->layout, bo);
     ASSERT_TRUE(second) << second.error();
-    const double error = compareMaps(*first, *cpu).relativeRmse();
+    const double error = compareMaps(*first, box->reference).relativeRmse();
     const double apart = compareMaps(*first, *second).relativeRmse() / std::sqrt(2.0);
     std::printf("[sun] 4 x 4 passes: seeds 1 and 2 apart %.4f / sqrt(2), seed 1's error %.4f\n", apart, error);
     EXPECT_GE(apart, error / 1.5) << "the seeds share part of their error";
@@ -393,20 +402,15 @@ TEST(SunBake, PassesGrowWithTheDirectionsAndLowerTheError) {
     bo.sunJitter = 3;
     EXPECT_EQ(sunJitterFor(bo), 3) << "a given count is kept";
 
-    const Scene scene = boxShadowScene();
-    auto layout = packLayout(scene, 128, 16.0f);
-    ASSERT_TRUE(layout) << layout.error();
-    ReferenceOptions ro;
-    ro.spp = 8192;
-    auto cpu = bakeReference(scene, *layout, ro);
-    ASSERT_TRUE(cpu) << cpu.error();
+    auto box = boxShadow(8192);
+    ASSERT_TRUE(box) << box.error();
     double error[2] = {0, 0};
     for (int k = 0; k < 2; ++k) {
         bo.directions = 4;
         bo.sunJitter = k == 0 ? 8 : 16;
-        auto gpu = bakeGpu(scene, *layout, bo);
+        auto gpu = bakeGpu(box->scene, box->layout, bo);
         ASSERT_TRUE(gpu) << gpu.error();
-        error[k] = compareMaps(*gpu, *cpu).relativeRmse();
+        error[k] = compareMaps(*gpu, box->reference).relativeRmse();
     }
     std::printf("[sun] box shadow against the reference: 8 x 8 passes %.4f, 16 x 16 %.4f\n", error[0], error[1]);
     EXPECT_LT(error[1], 0.8 * error[0]);
