@@ -104,7 +104,6 @@ struct BakeOptions {
     int supersample = 1;
 };
 
-// Figures every bake reports (stats.json).
 // The sun's passes per axis for `options`: sunJitter, or from the directions
 // sqrt(directions / 16) in [2, 16], so that the shadow edges' error falls
 // with the bundles' (mixed_lighting stopped at 6.5 % with 4). The cap was 8
@@ -113,6 +112,7 @@ struct BakeOptions {
 // so past 16 what is left is the footprint's, not the sun's sampling.
 int sunJitterFor(const BakeOptions& options);
 
+// Figures every bake reports (stats.json).
 struct BakeStats {
     int directionsDone = 0;
     int directionsTotal = 0;

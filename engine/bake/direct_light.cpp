@@ -198,8 +198,9 @@ void Baker::Impl::bakeSun() {
                 const glm::vec2 jitter((jx + 0.5f) / j - 0.5f, (jy + 0.5f) / j - 0.5f);
                 footprintSample = uint32_t(jy * j + jx);
                 oddSample = footprintSample % 2 == 1;
+                // each sun's seeds apart from the next's (--sun-jitter is at most 64: 4096 passes)
                 tracer->run(bundleFrame(glm::normalize(lights[li].direction), jitter, sunOptions.uniform, jitterUnit),
-                            sunOptions, uint32_t(li * 1000 + jy * j + jx), false, update, options.leafRuns);
+                            sunOptions, uint32_t(li * 4096 + jy * j + jx), false, update, options.leafRuns);
             }
         glUseProgram(sunNoiseProgram.id());
         bindDirectSums(*this);
