@@ -171,21 +171,21 @@ std::string Baker::Impl::footprintShiftDefine() const {
 }
 
 Status Baker::Impl::buildPrograms() {
-    const std::string shift = footprintShiftDefine();
-    const std::string rounding = roundingDefine() + shift;
+    const std::string rounding = roundingDefine();
+    const std::string shift = footprintShiftDefine();  // the programs that sample texels' footprints
     struct Spec {
         gl::Program* target;
         std::vector<std::string> files;
         std::string defines;
     } specs[] = {
-        {&updateProgram, {"lightmap/update.vert", "lightmap/update.frag"}, rounding + backSidesDefine()},
+        {&updateProgram, {"lightmap/update.vert", "lightmap/update.frag"}, rounding + shift + backSidesDefine()},
         {&updateLeafRunProgram, {"lightmap/update.vert", "lightmap/update.frag"},
-         rounding + backSidesDefine() + "#define LEAF_TABLE 1\n"},
+         rounding + shift + backSidesDefine() + "#define LEAF_TABLE 1\n"},
         {&updateCurvedLeafRunProgram, {"lightmap/curved.vert", "lightmap/update.frag"},
-         rounding + backSidesDefine() + "#define CURVED_FOOTPRINT 1\n#define LEAF_TABLE 1\n"},
+         rounding + shift + backSidesDefine() + "#define CURVED_FOOTPRINT 1\n#define LEAF_TABLE 1\n"},
         {&sunProgram, {"lightmap/update.vert", "lightmap/update.frag"}, shift + "#define SUN_PASS 1\n"},
         {&updateCurvedProgram, {"lightmap/curved.vert", "lightmap/update.frag"},
-         rounding + backSidesDefine() + "#define CURVED_FOOTPRINT 1\n"},
+         rounding + shift + backSidesDefine() + "#define CURVED_FOOTPRINT 1\n"},
         {&sunCurvedProgram, {"lightmap/curved.vert", "lightmap/update.frag"}, shift + "#define SUN_PASS 1\n#define CURVED_FOOTPRINT 1\n"},
         {&sunLeafRunProgram, {"lightmap/update.vert", "lightmap/update.frag"}, shift + "#define SUN_PASS 1\n#define LEAF_TABLE 1\n"},
         {&sunCurvedLeafRunProgram, {"lightmap/curved.vert", "lightmap/update.frag"},

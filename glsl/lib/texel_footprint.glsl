@@ -13,8 +13,9 @@
 // the seed (FOOTPRINT_SHIFT below), the same for every texel, so that any run
 // of consecutive samples is spread evenly over the square, and a texel's
 // samples depend on where it lies on its surface, not on where its chart lies
-// in the atlas (layouts of one density bake the same values). Candidates off the chart are replaced by hashed ones (uniform
-// over the part on the chart, as rejection sampling is); after 8 the centre.
+// in the atlas (layouts of one density bake the same values). Candidates off
+// the chart are replaced by hashed ones (uniform over the part on the chart,
+// as rejection sampling is); after 8 the centre.
 //
 // Needs lib/rounding.glsl (pcgHash, uniform01) and shared/mesh_layout.h.
 
