@@ -434,8 +434,11 @@ def sweep_point(exe, name, cfg, method, value, ref):
            "value": value, "seconds": seconds, "process_seconds": wall, "rel_rmse": c["rel_rmse"],
            "rmse": c["rmse"], "rel_mse": c["rel_mse"], "mean_ratio": c["mean_ratio"], "max_abs": c["max_abs"],
            "texels": c["texels"],
-           # bundlebake's own estimate of its noise, without a reference (stats.json noise.relative)
-           "noise_estimate": s.get("noise", {}).get("relative", "") if method == "bundlebake" else ""}
+           # bundlebake's own estimate of its error, without a reference: stats.json noise.error_estimate
+           # (its noise and the resolution probe's bias), or noise.relative where the bake was not probed
+           "noise_estimate": s.get("noise", {}).get("error_estimate", s.get("noise", {}).get("relative", ""))
+                             if method == "bundlebake" else "",
+           "resolution_estimate": s.get("noise", {}).get("resolution", "") if method == "bundlebake" else ""}
     log("[%s] %-10s %-10s %6d: %7.3f s (process %6.2f s) rel_rmse %.4f mean_ratio %.4f" %
         (name, method, row["param"], value, seconds, wall, c["rel_rmse"], c["mean_ratio"]))
     return row
@@ -455,7 +458,7 @@ def write_outputs(name, cfg, rows, ref_note, ref_seconds, measured=None):
     outdir = os.path.join(RESULTS, name)
     os.makedirs(outdir, exist_ok=True)
     fields = ["scene", "method", "param", "value", "seconds", "process_seconds", "rel_rmse", "rmse", "rel_mse",
-              "mean_ratio", "max_abs", "texels", "noise_estimate"]
+              "mean_ratio", "max_abs", "texels", "noise_estimate", "resolution_estimate"]
     with open(os.path.join(outdir, "results.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields)
         w.writeheader()
@@ -514,6 +517,8 @@ def write_outputs(name, cfg, rows, ref_note, ref_seconds, measured=None):
         # the bake's error against the truth: the converged reference's own noise is independent of it
         own = math.sqrt(max(r["rel_rmse"] ** 2 - (noise or 0.0) ** 2, 0.0))
         estimate = "%.4f" % r["noise_estimate"] if r["noise_estimate"] != "" else "-"
+        if r.get("resolution_estimate", "") != "":  # the resolution probe's share
+            estimate += " (resolution %.4f)" % r["resolution_estimate"]
         versus = "%.2f" % (r["noise_estimate"] / own) if r["noise_estimate"] != "" and own > 0 else "-"
         # both errors against the truth: the sweep's runs are as independent of the
         # converged reference's noise as the bake is
@@ -529,9 +534,11 @@ def write_outputs(name, cfg, rows, ref_note, ref_seconds, measured=None):
     lines.append("ratio = bundlebake's error / the reference baker's error at the same time (log-log interpolated); "
                  "the goal is <= 0.5. Ratio less the reference's noise: the same with both errors less the converged "
                  "reference's own noise (each sqrt(rel_rmse^2 - its noise^2)): the two bakers' errors against the "
-                 "truth, which the raw ratio pulls toward 1 where both near that floor. Own noise estimate: bundlebake's stats.json noise.relative, from the even and "
-                 "odd directions without a reference, and the bounces still to come (noise.lag; tables measured before "
-                 "2026-12-05 09:40 hold the noise only); it falls short of rel_rmse by the other biases. Less "
+                 "truth, which the raw ratio pulls toward 1 where both near that floor. Own noise estimate: bundlebake's stats.json noise.error_estimate, without a "
+                 "reference: the noise from the even and odd directions, the bounces still to come (noise.lag) and "
+                 "the resolution probe's bias (noise.resolution; tables measured before 2026-12-06 03:00 hold "
+                 "noise.relative, without it, and before 2026-12-05 09:40 the noise only); it falls short of rel_rmse "
+                 "by the other biases. Less "
                  "the reference's noise: sqrt(rel_rmse^2 - its noise^2), the bake's error against the truth (the two "
                  "are independent); estimate / error is the estimate over it (the goal: within 1.5x either way).")
     lines.append("")
@@ -551,6 +558,7 @@ def rewrite_tables(name, cfg):
         for k in ("seconds", "process_seconds", "rel_rmse", "rmse", "rel_mse", "mean_ratio", "max_abs"):
             r[k] = float(r[k])
         r["noise_estimate"] = float(r["noise_estimate"]) if r["noise_estimate"] else ""
+        r["resolution_estimate"] = float(r["resolution_estimate"]) if r.get("resolution_estimate") else ""
     with open(os.path.join(outdir, "table.md")) as f:
         head = f.read()
     when = re.search(r"Measured ([\d-]+ [\d:]+)\.", head)

@@ -26,7 +26,6 @@
 #include "layout/bake_mesh_gl.h"
 
 namespace bb {
-namespace {
 
 // One page's CHART_NEIGHBOUR_* bits (glsl/shared/bundle_layout.h): for each
 // texel the GPU covered (codes before dilation), the texels 1 and 2 away
@@ -53,6 +52,8 @@ void chartNeighbourBits(const std::vector<uint8_t>& codes, const std::vector<int
             }
         }
 }
+
+namespace {
 
 // One page of dilation codes (glsl/shared/bundle_layout.h), in place: covered
 // texels hold DILATION_SELF; every other texel gets the nearest covered texel
@@ -145,11 +146,15 @@ nlohmann::json BakeStats::toJson() const {
     j["throughput"] = {{"fragments", fragments}, {"fragments_per_second_bundle_pass", fragments / bundleSeconds},
                        {"texel_samples", updatedTexels}, {"texel_samples_per_second_update_pass", updatedTexels / updateSeconds}};
     j["seconds"] = {{"setup", secondsSetup}, {"importance", secondsImportance}, {"tiling", secondsTiling}, {"sun", secondsSun}, {"emitters", secondsEmitters}, {"bundle", secondsBundle}, {"update", secondsUpdate},
-                    {"resolve", secondsResolve}, {"combine", secondsCombine}, {"total", secondsTotal()}};
+                    {"resolve", secondsResolve}, {"combine", secondsCombine}, {"resolution_probe", secondsProbe},
+                    {"total", secondsTotal()}};
     if (combines > 0) j["combine"] = {{"count", combines}, {"bytes_sent", combineBytes}};
     j["noise"] = {{"relative", noiseRelative}, {"halves", noiseHalves}, {"direct", noiseDirect}, {"lag", noiseLag},
                   {"sampled_texels", noiseTexels}, {"stride", noiseStride}, {"stopped_at_target", stoppedAtTargetNoise},
                   {"history", noiseHistory}};
+    if (noiseResolution >= 0)
+        j["noise"].update({{"resolution", noiseResolution}, {"error_estimate", errorEstimate()},
+                           {"resolution_probe_directions", resolutionProbeDirections}});
     return j;
 }
 
@@ -908,6 +913,7 @@ void Baker::Impl::run(double seconds, bool wholeDirections) {
             stepTile();
         if (secondsSince(t0) >= seconds) break;
     }
+    if (stats.directionsDone >= directionsGoal() && !probed) probeResolution();
     noteMemory();
 }
 

@@ -12,6 +12,7 @@
 // same bytes. Requires a current GL 4.3 context for its whole life.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -102,7 +103,17 @@ struct BakeOptions {
     // autoSupersample decides by the layout and the memory budget
     // (BakeStats::supersample says which).
     int supersample = 1;
+    // The resolution probe (bake/resolution_probe.cpp), after the last
+    // direction of a supersampled bake: this many directions gathered twice,
+    // reading the radiance at the baked texels and at twice their size, whose
+    // difference estimates the bias of reading light at the light map's
+    // resolution (BakeStats::noiseResolution). 0: none; -1: the directions /
+    // 32 in [8, 64].
+    int resolutionProbe = 0;
 };
+
+// The resolution probe's directions for `options` (0: none).
+int resolutionProbeDirections(const BakeOptions& options);
 
 // The sun's passes per axis for `options`: sunJitter, or from the directions
 // sqrt(directions / 16) in [2, 16], so that the shadow edges' error falls
@@ -181,9 +192,19 @@ struct BakeStats {
     int64_t noiseTexels = 0;          // sampled texels the last estimate used
     std::vector<std::pair<int, double>> noiseHistory;  // (directions done, noiseRelative) at refreshes
     bool stoppedAtTargetNoise = false;
+    // The resolution probe's estimate (bake/resolution_probe.cpp): the RMS of
+    // the bias of reading the light at the light map's resolution, over the
+    // maps' mean, at the same texels; < 0: not probed. Not in noiseRelative
+    // (more directions do not lower it); errorEstimate() adds the two.
+    double noiseResolution = -1;
+    int resolutionProbeDirections = 0;
+    double secondsProbe = 0;
+    double errorEstimate() const {
+        return noiseResolution < 0 || noiseRelative < 0 ? noiseRelative : std::hypot(noiseRelative, noiseResolution);
+    }
     double secondsTotal() const {
         return secondsSetup + secondsSun + secondsEmitters + secondsTiling + secondsBundle + secondsUpdate +
-               secondsResolve + secondsCombine;
+               secondsResolve + secondsCombine + secondsProbe;
     }
     nlohmann::json toJson() const;
 };

@@ -21,6 +21,11 @@
 
 namespace bb {
 
+// One page's CHART_NEIGHBOUR_* bits (glsl/shared/bundle_layout.h) from its
+// coverage codes (before dilation) and texel owners (baker.cpp).
+void chartNeighbourBits(const std::vector<uint8_t>& codes, const std::vector<int32_t>& owner,
+                        const std::vector<uint32_t>& chart, int res, std::vector<uint8_t>& bits);
+
 struct Baker::Impl {
     BakeOptions options;
     BakeMesh mesh;
@@ -184,6 +189,10 @@ struct Baker::Impl {
     // Direction k: the history ramp, then its tiles one by one; the round's end
     // (bake/direction_share.h), with the refresh when one is due.
     void beginDirection(int k);
+    uint32_t directionSeed(int k) const;      // direction k's random numbers (bundle and update passes)
+    BundleFrame directionFrame(int k) const;  // its root square, at its random phase
+    // An update program's uniforms and textures for direction k at `sampleWeight` (used by it)
+    void setUpdateUniforms(const gl::Program& program, double sampleWeight, int k) const;
     void stepTile();
     void stepDirection();  // tiles until the direction in flight (or the next) is done
     // Baker::step (whole directions) and stepTiles: until `seconds` have passed, at least one step.
@@ -237,6 +246,10 @@ struct Baker::Impl {
     // noise.cpp: `m` advanced through the schedule's rounds up to `rounds`
     // under a ramp ending at `plateau`, for a mode that keeps `lambda` a bounce
     void runLagModel(LagModel& m, int rounds, int plateau, double lambda) const;
+    // resolution_probe.cpp: after the last direction, stats.noiseResolution (once)
+    void probeResolution();
+    bool probed = false;
+    double noiseMean = 0;  // the maps' mean over the noise estimate's sampled texels (estimateNoise)
     int directionsGoal() const { return stats.stoppedAtTargetNoise ? stats.directionsDone : options.directions; }
 };
 

@@ -102,6 +102,13 @@ public:
     // its first texel (clusterFirst; empty: none), and what binds their
     // records for a draw of them with the program given (drawCurvedTexelRuns).
     void setCurvedTexels(std::vector<uint32_t> clusterFirst, std::function<void(GLuint)> bind);
+    // The outgoing radiance the bundle pass reads, its read modes and texel
+    // charts (BundleScene's): the resolution probe's coarse maps, then back.
+    void setRadianceSource(GLuint radiance, GLuint readModes, GLuint texelCharts) {
+        scene_.radiance = radiance;
+        scene_.readModes = readModes;
+        scene_.texelCharts = texelCharts;
+    }
 
     // Both passes read the triangle and vertex buffers as SSBOs in chunks of
     // GL_MAX_SHADER_STORAGE_BLOCK_SIZE (MeshChunks, layout/bake_mesh_gl.h):

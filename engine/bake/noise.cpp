@@ -178,6 +178,7 @@ void Baker::Impl::estimateNoise() {
     // the bundles' and the direct light's (drawn apart: their noises add)
     variance = variance * noiseHalvesFactor() + direct;
     const double mean = sum / (3.0 * double(texels));
+    noiseMean = mean;
     stats.noiseHalves = std::sqrt(variance / (3.0 * double(texels))) / mean;
     stats.noiseDirect = std::sqrt(direct / (3.0 * double(texels))) / mean;
     // the lag l scales the bounced light (the bundles' means, RMS b), not the direct light beside it: the

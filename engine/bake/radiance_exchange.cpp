@@ -20,7 +20,6 @@
 namespace bb {
 
 void Baker::Impl::beginDirection(int k) {
-    const glm::vec3 d = directions[size_t(k)];
     // history ramp: weight min(j+1, plateau)^power relative to the stored
     // scale, j the round (the direction, baked alone): a round adds a bounce
     const double logWeight = rampLogWeight(k / shareCount());
@@ -30,40 +29,51 @@ void Baker::Impl::beginDirection(int k) {
         accumLogScale = logWeight;
         sampleWeight = 1.0;
     }
-    const uint32_t seed = pcgHash(uint32_t(options.seed) * 0x9E3779B1u ^ pcgHash(uint32_t(k)));
-    directionUpdate = [this, sampleWeight, seed, k](const TileFrame& f, uint32_t) {
-        const bool useEnv = bool(envTexture);
-        const glm::vec3 sky = options.sky / radianceUnit;
+    const uint32_t seed = directionSeed(k);
+    directionUpdate = [this, sampleWeight, k](const TileFrame& f, uint32_t) {
         const gl::Program& triangles = f.leafRun ? updateLeafRunProgram : updateProgram;
         const gl::Program& curved = f.leafRun ? updateCurvedLeafRunProgram : updateCurvedProgram;
-        for (const gl::Program* program : {&triangles, &curved}) {
-            glUseProgram(program->id());
-            glUniform1f(program->uniform("sampleWeight"), float(sampleWeight));
-            // per direction, not per tile: each texel is updated once per direction, and tiles change with the budget
-            glUniform1ui(program->uniform("randomSeed"), seed);
-            glUniform3fv(program->uniform("sky"), 1, &sky.x);
-            glUniform1i(program->uniform("useEnv"), useEnv);
-            // the noise estimate's halves: the odd directions are the second of the
-            // two independently rotated sets (bake/directions.h)
-            glUniform1i(program->uniform("oddDirection"), k % 2);
-            glUniform1i(program->uniform("halfStride"), stats.noiseStride);
-            glUniform1i(program->uniform("supersample"), options.supersample);
-            glUniform1i(program->uniform("backLayerOffset"), backLayerOffset);
-            glUniform1f(program->uniform("depthBias"), depthBias);
-            glUniform1ui(program->uniform("footprintSample"), uint32_t(k));
-        }
+        for (const gl::Program* program : {&triangles, &curved}) setUpdateUniforms(*program, sampleWeight, k);
         glBindImageTexture(BINDING_HALF_ACCUM, halfAccum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
-        glBindTextureUnit(BINDING_FOOTPRINT, footprint.id());
-        if (useEnv) glBindTextureUnit(BINDING_ENV, envTexture.id());
         glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
         return BundleTracer::UpdatePrograms{triangles.id(), curvedTexelCount() ? curved.id() : 0u};
     };
+    tracer->begin(directionFrame(k), tilerOptions, seed, true, options.leafRuns);
+    directionActive = true;
+}
+
+uint32_t Baker::Impl::directionSeed(int k) const {
+    return pcgHash(uint32_t(options.seed) * 0x9E3779B1u ^ pcgHash(uint32_t(k)));
+}
+
+BundleFrame Baker::Impl::directionFrame(int k) const {
     // the grid's phase, random per direction: where the bundle grid beats against
     // the light map's texels, the pattern moves from direction to direction and
     // averages out instead of settling into stripes (issue 11)
+    const uint32_t seed = directionSeed(k);
     const glm::vec2 phase(uniform01(pcgHash(seed ^ 0x5bd1e995u)) - 0.5f, uniform01(pcgHash(seed ^ 0x1b873593u)) - 0.5f);
-    tracer->begin(bundleFrame(d, phase, tilerOptions.uniform, pixelSize), tilerOptions, seed, true, options.leafRuns);
-    directionActive = true;
+    return bundleFrame(directions[size_t(k)], phase, tilerOptions.uniform, pixelSize);
+}
+
+void Baker::Impl::setUpdateUniforms(const gl::Program& program, double sampleWeight, int k) const {
+    const bool useEnv = bool(envTexture);
+    const glm::vec3 sky = options.sky / radianceUnit;
+    glUseProgram(program.id());
+    glUniform1f(program.uniform("sampleWeight"), float(sampleWeight));
+    // per direction, not per tile: each texel is updated once per direction, and tiles change with the budget
+    glUniform1ui(program.uniform("randomSeed"), directionSeed(k));
+    glUniform3fv(program.uniform("sky"), 1, &sky.x);
+    glUniform1i(program.uniform("useEnv"), useEnv);
+    // the noise estimate's halves: the odd directions are the second of the
+    // two independently rotated sets (bake/directions.h)
+    glUniform1i(program.uniform("oddDirection"), k % 2);
+    glUniform1i(program.uniform("halfStride"), stats.noiseStride);
+    glUniform1i(program.uniform("supersample"), options.supersample);
+    glUniform1i(program.uniform("backLayerOffset"), backLayerOffset);
+    glUniform1f(program.uniform("depthBias"), depthBias);
+    glUniform1ui(program.uniform("footprintSample"), uint32_t(k));
+    glBindTextureUnit(BINDING_FOOTPRINT, footprint.id());
+    if (useEnv) glBindTextureUnit(BINDING_ENV, envTexture.id());
 }
 
 void Baker::Impl::stepTile() {

@@ -67,6 +67,13 @@ uniform uint randomSeed;
 // kept at every halfStride-th texel of each axis.
 layout(binding = BINDING_HALF_ACCUM, rg32ui) uniform coherent uimage2DArray halfAccum;
 uniform bool oddDirection;
+#ifdef RESOLUTION_PROBE
+// The resolution probe (engine/bake/resolution_probe.cpp): this pass's
+// samples, weighted, into its layers of the probe's sums at the noise
+// estimate's sampled texels; the bake's own accumulators stay as they are.
+layout(binding = BINDING_PROBE_SUMS, rgba32f) uniform coherent image2DArray probeSums;
+uniform int probeLayer;
+#endif
 uniform int backLayerOffset;  // BACK_SIDES: double-sided triangles' back sides' accumulators at layer page + this
 #endif
 uniform int halfStride;
@@ -536,6 +543,14 @@ void main() {
     vec3 incoming = incomingRadiance(bestNode, seenSide, ahead ? bundleDir : -bundleDir);
     // the running cosine-weighted mean of L_in (rgb) and its weight W (a)
     float w = sampleWeight * cosine * s.weight;
+#ifdef RESOLUTION_PROBE
+    ivec3 probed;
+    if (noiseHalfTexel(texel, probed)) {
+        probed.z += probeLayer;
+        imageStore(probeSums, probed, imageLoad(probeSums, probed) + vec4(incoming * w, w));
+    }
+    return;
+#endif
     uint h = pcgHash(randomSeed ^ pcgHash(uint(texel.x) | (uint(texel.y) << 16u)) ^ pcgHash(uint(texel.z) + 7919u));
     imageStore(accum, texel, uvec4(foldSample(imageLoad(accum, texel).rg, incoming, w, h), 0u, 0u));
 #ifdef BACK_SIDES

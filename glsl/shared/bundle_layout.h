@@ -61,6 +61,7 @@ struct LeafRecord {
 #define BINDING_DIRECT_ODD_SUMS 6  // image unit, direct light passes only: rgba32f an emitter triangle's or a sun's
                                    // odd samples' sums at the noise estimate's sampled texels (halfAccum's size)
 #define BINDING_DIRECT_VARIANCE 7  // image unit, direct light passes only: r32f its light's variance per sampled texel
+#define BINDING_PROBE_SUMS 7      // image unit, resolution probe's update pass only: rgba32f sums (bake/resolution_probe.cpp)
 #define BINDING_DIRECT_WEIGHTS 1   // image unit, direct noise pass only: the noise weights (BINDING_NOISE_WEIGHTS')
 #define BINDING_RADIANCE 0       // texture unit: RGB9_E5 outgoing radiance Lo per texel, array of pages
 #define BINDING_ENV 1            // texture unit: environment map (equirectangular)

@@ -80,6 +80,12 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
         ->check(CLI::Range(0, 64))
         ->capture_default_str();
     addSupersampleOption(cmd, a.supersample);
+    cmd.add_option("--resolution-probe", a.resolutionProbe,
+                   "Directions gathered again at the end of a supersampled bake, reading its light at twice the texel, "
+                   "to estimate the error of the light map's resolution (stats.json noise.resolution; -1 = directions "
+                   "/ 32 in [8, 64], 0 = off)")
+        ->check(CLI::Range(-1, 1 << 16))
+        ->capture_default_str();
     cmd.add_option("--target-noise", a.targetNoise,
                    "Stop once the light maps' estimated relative error (their noise and the bounces still to come) is "
                    "at most this (e.g. 0.01; checked at radiance refreshes from 16 directions on; --directions is then "
@@ -161,6 +167,7 @@ int runBake(const BakeArgs& args) {
                                                     : BakeOptions::DirectLight::Auto;
     options.emitterSamples = args.emitterSamples;
     options.sunJitter = args.sunJitter;
+    options.resolutionProbe = args.resolutionProbe;
     options.share = mpi;
     options.targetNoise = args.targetNoise;
     options.supersample = supersampleValue(args.supersample);
@@ -234,7 +241,7 @@ int runBake(const BakeArgs& args) {
                      {"texel_density", args.scene.texelDensity}, {"history_power", (*baker)->stats().historyPower},
                      {"history_plateau", (*baker)->stats().historyPlateau},
                      {"direct", args.direct}, {"emitter_samples", args.emitterSamples},
-                     {"sun_jitter", args.sunJitter},
+                     {"sun_jitter", args.sunJitter}, {"resolution_probe", args.resolutionProbe},
                      {"seams", args.seams}, {"supersample", args.supersample}, {"mpi_ranks", mpi ? mpi->count() : 1}, {"target_noise", args.targetNoise}};
     info.wallSeconds = seconds;
     info.writePreviews = args.preview;

@@ -51,6 +51,7 @@ struct BakeArgs {
     std::string direct = "auto";
     int emitterSamples = 0;
     int sunJitter = 0;
+    int resolutionProbe = -1;         // BakeOptions::resolutionProbe (-1: from the directions)
     std::string supersample = "auto";  // auto | 1 | 2 | 4 (BakeOptions::supersample)
     std::string seams = "stitch";     // stitch | off (bake/seam_stitch.h)
     bool preview = true;
