@@ -38,7 +38,11 @@ namespace bb {
 
 int resolutionProbeDirections(const BakeOptions& options) {
     if (options.resolutionProbe >= 0) return std::min(options.resolutionProbe, options.directions);
-    return std::min(std::clamp(options.directions / 32, 8, 64), options.directions);
+    // about 3 % of the bake's passes from 128 directions on: the estimate holds
+    // within its noise from 2 (the shared Cornell box at 256 directions: 0.0280 /
+    // 0.0281 / 0.0292 with 2 / 4 / 8; at 1024, 0.0276 / 0.0291 / 0.0268 / 0.0272
+    // with 8 / 16 / 32 / 64)
+    return std::min(std::clamp(options.directions / 64, 2, 32), options.directions);
 }
 
 namespace {
