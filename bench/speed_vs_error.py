@@ -434,10 +434,9 @@ def sweep_point(exe, name, cfg, method, value, ref):
            "value": value, "seconds": seconds, "process_seconds": wall, "rel_rmse": c["rel_rmse"],
            "rmse": c["rmse"], "rel_mse": c["rel_mse"], "mean_ratio": c["mean_ratio"], "max_abs": c["max_abs"],
            "texels": c["texels"],
-           # bundlebake's own estimate of its error, without a reference: stats.json noise.error_estimate
-           # (its noise and the resolution probe's bias), or noise.relative where the bake was not probed
-           "noise_estimate": s.get("noise", {}).get("error_estimate", s.get("noise", {}).get("relative", ""))
-                             if method == "bundlebake" else "",
+           # bundlebake's own estimates, without a reference: its noise (stats.json noise.relative) and the
+           # resolution probe's bias (noise.resolution), where the bake was probed
+           "noise_estimate": s.get("noise", {}).get("relative", "") if method == "bundlebake" else "",
            "resolution_estimate": s.get("noise", {}).get("resolution", "") if method == "bundlebake" else ""}
     log("[%s] %-10s %-10s %6d: %7.3f s (process %6.2f s) rel_rmse %.4f mean_ratio %.4f" %
         (name, method, row["param"], value, seconds, wall, c["rel_rmse"], c["mean_ratio"]))
@@ -509,36 +508,41 @@ def write_outputs(name, cfg, rows, ref_note, ref_seconds, measured=None):
                      "below)." % noise)
         lines.append("")
     lines += ["| baker | setting | time s | process s | rel_rmse | less the reference's noise | own noise estimate | "
-              "estimate / error | mean_ratio | max_abs | reference's rel_rmse at equal time | ratio | "
-              "ratio less the reference's noise |",
-              "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+              "estimate / error | resolution probe | both / error | mean_ratio | max_abs | "
+              "reference's rel_rmse at equal time | ratio | ratio less the reference's noise |",
+              "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in gpu:
         at = interp_loglog(cpu_curve, r["seconds"])
         # the bake's error against the truth: the converged reference's own noise is independent of it
         own = math.sqrt(max(r["rel_rmse"] ** 2 - (noise or 0.0) ** 2, 0.0))
         estimate = "%.4f" % r["noise_estimate"] if r["noise_estimate"] != "" else "-"
-        if r.get("resolution_estimate", "") != "":  # the resolution probe's share
-            estimate += " (resolution %.4f)" % r["resolution_estimate"]
         versus = "%.2f" % (r["noise_estimate"] / own) if r["noise_estimate"] != "" and own > 0 else "-"
+        # with the resolution probe's bias (noise.error_estimate), where the bake was probed
+        resolution, with_resolution = "-", "-"
+        if r.get("resolution_estimate", "") != "" and r["noise_estimate"] != "":
+            resolution = "%.4f" % r["resolution_estimate"]
+            if own > 0:
+                with_resolution = "%.2f" % (math.hypot(r["noise_estimate"], r["resolution_estimate"]) / own)
         # both errors against the truth: the sweep's runs are as independent of the
         # converged reference's noise as the bake is
         at_own = math.sqrt(max(at ** 2 - (noise or 0.0) ** 2, 0.0)) if at else 0.0
-        lines.append("| bundlebake | %d directions | %.3f | %.2f | %.4f | %.4f | %s | %s | %.4f | %.4g | %s | %s | %s |" %
+        lines.append("| bundlebake | %d directions | %.3f | %.2f | %.4f | %.4f | %s | %s | %s | %s | %.4f | %.4g | %s | %s | %s |" %
                      (r["value"], r["seconds"], r["process_seconds"], r["rel_rmse"], own, estimate, versus,
-                      r["mean_ratio"], r["max_abs"], "%.4f" % at if at else "out of range",
+                      resolution, with_resolution, r["mean_ratio"], r["max_abs"], "%.4f" % at if at else "out of range",
                       "%.2f" % (r["rel_rmse"] / at) if at else "-", "%.2f" % (own / at_own) if at_own > 0 else "-"))
     for r in cpu:
-        lines.append("| reference | %d spp | %.3f | %.2f | %.4f | | | | %.4f | %.4g | | | |" %
+        lines.append("| reference | %d spp | %.3f | %.2f | %.4f | | | | | | %.4f | %.4g | | | |" %
                      (r["value"], r["seconds"], r["process_seconds"], r["rel_rmse"], r["mean_ratio"], r["max_abs"]))
     lines.append("")
     lines.append("ratio = bundlebake's error / the reference baker's error at the same time (log-log interpolated); "
                  "the goal is <= 0.5. Ratio less the reference's noise: the same with both errors less the converged "
                  "reference's own noise (each sqrt(rel_rmse^2 - its noise^2)): the two bakers' errors against the "
-                 "truth, which the raw ratio pulls toward 1 where both near that floor. Own noise estimate: bundlebake's stats.json noise.error_estimate, without a "
-                 "reference: the noise from the even and odd directions, the bounces still to come (noise.lag) and "
-                 "the resolution probe's bias (noise.resolution; tables measured before 2026-12-06 03:00 hold "
-                 "noise.relative, without it, and before 2026-12-05 09:40 the noise only); it falls short of rel_rmse "
-                 "by the other biases. Less "
+                 "truth, which the raw ratio pulls toward 1 where both near that floor. Own noise estimate: bundlebake's stats.json noise.relative, from the even and "
+                 "odd directions without a reference, and the bounces still to come (noise.lag; tables measured before "
+                 "2026-12-05 09:40 hold the noise only); it falls short of rel_rmse by the other biases. Resolution "
+                 "probe: noise.resolution, the bias of reading light a texel at a time (since 2026-12-06; an upper "
+                 "estimate where charts are narrower than a texel), and both / error: noise.error_estimate, the two "
+                 "added in quadrature, over the error. Less "
                  "the reference's noise: sqrt(rel_rmse^2 - its noise^2), the bake's error against the truth (the two "
                  "are independent); estimate / error is the estimate over it (the goal: within 1.5x either way).")
     lines.append("")

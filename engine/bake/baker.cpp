@@ -154,7 +154,8 @@ nlohmann::json BakeStats::toJson() const {
                   {"history", noiseHistory}};
     if (noiseResolution >= 0)
         j["noise"].update({{"resolution", noiseResolution}, {"error_estimate", errorEstimate()},
-                           {"resolution_probe_directions", resolutionProbeDirections}});
+                           {"resolution_probe_directions", resolutionProbeDirections},
+                           {"resolution_order", resolutionOrder}});
     return j;
 }
 
