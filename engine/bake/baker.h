@@ -108,7 +108,7 @@ struct BakeOptions {
     // reading the radiance at the baked texels and at twice their size, whose
     // difference estimates the bias of reading light at the light map's
     // resolution (BakeStats::noiseResolution). 0: none; -1: the directions /
-    // 64, at least 2.
+    // 64, at least 8, from 256 directions on.
     int resolutionProbe = 0;
 };
 

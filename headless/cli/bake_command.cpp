@@ -83,7 +83,7 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
     cmd.add_option("--resolution-probe", a.resolutionProbe,
                    "Directions gathered again at the end of a supersampled bake, reading its light at twice the texel, "
                    "to estimate the error of the light map's resolution (stats.json noise.resolution; -1 = directions "
-                   "/ 64, at least 2; 0 = off)")
+                   "/ 64, at least 8, from 256 directions on; 0 = off)")
         ->check(CLI::Range(-1, 1 << 16))
         ->capture_default_str();
     cmd.add_option("--target-noise", a.targetNoise,
