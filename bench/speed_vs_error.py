@@ -541,7 +541,7 @@ def write_outputs(name, cfg, rows, ref_note, ref_seconds, measured=None):
                  "odd directions without a reference, and the bounces still to come (noise.lag; tables measured before "
                  "2026-12-05 09:40 hold the noise only); it falls short of rel_rmse by the other biases. Resolution "
                  "probe: noise.resolution, the bias of reading light a texel at a time (since 2026-12-06; an upper "
-                 "estimate where charts are narrower than a texel), and both / error: noise.error_estimate, the two "
+                 "estimate where charts are about a texel wide), and both / error: noise.error_estimate, the two "
                  "added in quadrature, over the error. Less "
                  "the reference's noise: sqrt(rel_rmse^2 - its noise^2), the bake's error against the truth (the two "
                  "are independent); estimate / error is the estimate over it (the goal: within 1.5x either way).")

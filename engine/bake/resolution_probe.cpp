@@ -24,9 +24,9 @@
 // estimates the bias's mean square without the probe's own noise in it. The
 // bake's maps are not touched (the same bytes with or without the probe).
 //
-// An upper estimate where charts are narrower than the coarser texels: the
-// coarser maps cannot hold such strips (a strip's rays then read its
-// neighbour's light), so D measures more than the baked reads' bias. Against
+// An upper estimate where charts are about as narrow as the coarser texels:
+// there the coarser reads err by more than a scaled copy of the baked reads'
+// error (past Richardson's range), so D measures more than their bias. Against
 // converged references (design notes, "The resolution probe"): the shared
 // Cornell box's slot rim and the city's own atlas within their noise, the
 // Cornell box and the two rooms small as they should be, mixed_lighting 1.6x
