@@ -220,6 +220,8 @@ struct Baker::Impl {
     // The outgoing radiance the bundles read: meta.frag over every page, then the padding.
     void refreshRadiance(uint32_t key);  // key: the direction just done (random numbers)
     void updateReadModes();              // readModes from the radiance map (after a refresh or a restore)
+    // read_modes.comp over maps of `res` texels a side (the bake's, or the resolution probe's coarser ones)
+    void computeReadModes(const gl::Texture& neighbours, const gl::Texture& bits, const gl::Texture& modes, int res);
     // L_lm of the region (x 0.., y0.., page) + (width, rows, pages) into `target` at (0, 0, 0).
     void resolveInto(const gl::Texture& target, int y0, int rows, int page0, int pages);
     void dispatchPages(GLuint program, int layers = 0);  // layers: 0 = the pages

@@ -201,14 +201,20 @@ void Baker::Impl::refreshRadiance(uint32_t key) {
     updateReadModes();
 }
 
-void Baker::Impl::updateReadModes() {
+void Baker::Impl::updateReadModes() { computeReadModes(chartNeighbours, radianceBits, readModes, layout.resolution); }
+
+void Baker::Impl::computeReadModes(const gl::Texture& neighbours, const gl::Texture& bits, const gl::Texture& modes,
+                                   int res) {
     gl::DebugGroup group("radiance read modes");
     glUseProgram(readModesProgram.id());
     glUniform1i(readModesProgram.uniform("codePages"), layout.pageCount);
-    glBindImageTexture(BINDING_CHART_NEIGHBOURS_IMAGE, chartNeighbours.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_R8UI);
-    glBindImageTexture(BINDING_RADIANCE_BITS, radianceBits.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_R32UI);
-    glBindImageTexture(BINDING_READ_MODES_IMAGE, readModes.id(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R8UI);
-    dispatchPages(readModesProgram.id(), stateLayers());
+    glUniform1i(readModesProgram.uniform("pageCount"), stateLayers());
+    glUniform2i(readModesProgram.uniform("pageSize"), res, res);
+    glBindImageTexture(BINDING_CHART_NEIGHBOURS_IMAGE, neighbours.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_R8UI);
+    glBindImageTexture(BINDING_RADIANCE_BITS, bits.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_R32UI);
+    glBindImageTexture(BINDING_READ_MODES_IMAGE, modes.id(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R8UI);
+    glDispatchCompute(GLuint(res + 7) / 8, GLuint(res + 7) / 8, GLuint(stateLayers()));
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
 }
 
 void Baker::Impl::resolveInto(const gl::Texture& target, int y0, int rows, int page0, int pages) {

@@ -132,11 +132,10 @@ void Baker::Impl::probeResolution() {
             gl::writeTexture(to.neighbours.id(), 0, 0, p, r, r, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, neighbours.data());
             // the weights of `from`'s texels in `to`'s: the reduction's from the baked
             // level; an output texel's its baked texels' sum where it shares its chart
-            std::vector<float> w;
-            if (&from == &baked) {
-                w = weights[size_t(p)];
-            } else {
-                w.assign(size_t(from.res) * from.res, 0.0f);
+            std::vector<float> summed;
+            const std::vector<float>& w = &from == &baked ? weights[size_t(p)] : summed;
+            if (&from != &baked) {
+                summed.assign(size_t(from.res) * from.res, 0.0f);
                 const std::vector<float>& fine = weights[size_t(p)];
                 for (int y = 0; y < from.res; ++y)
                     for (int x = 0; x < from.res; ++x) {
@@ -146,7 +145,7 @@ void Baker::Impl::probeResolution() {
                         float sum = 0.0f;
                         for (int j = 0; j < k; ++j)
                             for (int i = 0; i < k; ++i) sum += fine[size_t(y * k + j) * res + size_t(x * k + i)];
-                        w[size_t(y) * from.res + x] = sum;
+                        summed[size_t(y) * from.res + x] = sum;
                     }
             }
             for (int side = 0; side < (backLayerOffset ? 2 : 1); ++side) {  // the page, its back sides' layer
@@ -172,15 +171,7 @@ void Baker::Impl::probeResolution() {
                 gl::writeTexture(to.radiance.id(), 0, 0, layer, r, r, 1, GL_RGB, GL_FLOAT, 12, out.data());
             }
         }
-        glUseProgram(readModesProgram.id());
-        glUniform1i(readModesProgram.uniform("codePages"), pages);
-        glUniform1i(readModesProgram.uniform("pageCount"), layers);
-        glUniform2i(readModesProgram.uniform("pageSize"), r, r);
-        glBindImageTexture(BINDING_CHART_NEIGHBOURS_IMAGE, to.neighbours.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_R8UI);
-        glBindImageTexture(BINDING_RADIANCE_BITS, to.bits.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_R32UI);
-        glBindImageTexture(BINDING_READ_MODES_IMAGE, to.modes.id(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R8UI);
-        glDispatchCompute(GLuint(r + 7) / 8, GLuint(r + 7) / 8, GLuint(layers));
-        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+        computeReadModes(to.neighbours, to.bits, to.modes, r);
     };
     CoarseLevel output, twice;
     output.res = outputLayout.resolution;
