@@ -155,7 +155,7 @@ nlohmann::json BakeStats::toJson() const {
     if (noiseResolution >= 0)
         j["noise"].update({{"resolution", noiseResolution}, {"error_estimate", errorEstimate()},
                            {"resolution_probe_directions", resolutionProbeDirections},
-                           {"resolution_order", resolutionOrder}});
+                           {"resolution_order", resolutionOrder}, {"resolution_past_range", resolutionPastRange}});
     return j;
 }
 

@@ -198,7 +198,8 @@ struct BakeStats {
     // (more directions do not lower it); errorEstimate() adds the two.
     double noiseResolution = -1;
     int resolutionProbeDirections = 0;
-    double resolutionOrder = 0;  // p in the bias's h^p, from the probe's two steps, in [1, 2]
+    double resolutionOrder = 0;      // p in the bias's h^p, from the probe's two steps, in [1, 2]; 0: none in range
+    double resolutionPastRange = 0;  // share of what coarser reads change in texels past Richardson's range
     double secondsProbe = 0;
     double errorEstimate() const {
         return noiseResolution < 0 || noiseRelative < 0 ? noiseRelative : std::hypot(noiseRelative, noiseResolution);

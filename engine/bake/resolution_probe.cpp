@@ -16,23 +16,27 @@
 // its texels' charts, neighbours and read modes. The passes of a direction
 // share every random number, so the differences D1 (output - baked) and D2
 // (twice - output) are the changes that coarser reads make, with little noise
-// of their own. Richardson: for a bias b(h) = c h^p, D1 = b (k^p - 1); the
-// order p comes from D2 / D1, held to [1, 2] (light that steps within a
-// texel errs as h: the reconstruction keeps each texel's mean, and the part
-// a receiver sees wrongly scales with h; smooth light as h^2). The even and
-// odd probe directions give two independent D; the sum of their products
-// estimates the bias's mean square without the probe's own noise in it. The
-// bake's maps are not touched (the same bytes with or without the probe).
+// of their own. Richardson, texel by texel (richardsonBias): for a bias
+// b(h) = c h^p, D1 = b (k^p - 1), and the order p comes from D2 / D1, held to
+// [1, 2]. The even and odd probe directions give two independent D; the sum of
+// their products estimates the bias's mean square without the probe's own
+// noise in it. The bake's maps are not touched (the same bytes with or
+// without the probe).
 //
-// An upper estimate where charts are about as narrow as the coarser texels:
-// there the coarser reads err by more than a scaled copy of the baked reads'
-// error (past Richardson's range), so D measures more than their bias. Against
-// converged references (design notes, "The resolution probe"): the shared
-// Cornell box's slot rim and the city's own atlas within their noise, the
-// Cornell box and the two rooms small as they should be, mixed_lighting 1.6x
-// and the street canyon's strips up to 2.7x over.
+// It sees only light whose detail the baked texels hold and coarser ones lose
+// step by step. Where a texel's second step changes less than its first (the
+// output's texels already lose the detail outright: charts about a texel wide,
+// the street canyon's sills and lintels) the texel is past Richardson's range
+// and left out (taken with p = 1 they put the error estimate at 2.9x the
+// canyon's error and 2.3x mixed_lighting's at 4096 directions, and matched the
+// shared Cornell box's slot rim only by chance: its error sits in texels whose
+// steps are small). Light that changes within a baked texel's part (the slot's panel
+// within millimetres of its edge) it cannot see at all: that needs a finer
+// bake, not coarser reads (design notes, "The resolution probe").
 #include <algorithm>
 #include <cmath>
+
+#include "bake/resolution_probe.h"
 
 #include "bake/baker_impl.h"
 #include "bake/supersample.h"
@@ -223,17 +227,15 @@ void Baker::Impl::probeResolution() {
     glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
 
     // Each sampled texel's six values (its half-size texels' means at the
-    // reduction's weights, as noise.comp forms the halves'), their steps from
-    // level to level, and the sums of the halves' products.
+    // reduction's weights, as noise.comp forms the halves'), and their steps
+    // from level to level.
     const size_t slotTexels = size_t(halfWidth) * halfWidth * pages;
     std::vector<glm::vec4> values(slotTexels * kSlots);
     gl::readTexture(sums.id(), 0, 0, 0, halfWidth, halfWidth, kSlots * pages, GL_RGBA, GL_FLOAT, 16, values.data());
     std::vector<float> texelWeights(slotTexels);
     gl::readTexture(noiseWeights.id(), 0, 0, 0, halfWidth, halfWidth, pages, GL_RED, GL_FLOAT, 4, texelWeights.data());
     const int width = halfWidth / k;
-    // per step (baked -> output, output -> twice) the sum of D_e . D_o, and its variance where no bias is
-    double products[2] = {0, 0}, variances[2] = {0, 0};
-    int64_t texels = 0;
+    std::vector<ProbeSteps> steps;
     for (int p = 0; p < pages; ++p)
         for (int y = 0; y < width; ++y)
             for (int x = 0; x < width; ++x) {
@@ -253,44 +255,65 @@ void Baker::Impl::probeResolution() {
                     complete = weight > 0;
                     mean[s] = complete ? sum / weight : glm::dvec3(0.0);
                 }
-                if (!complete) continue;
-                for (int step = 0; step < 2; ++step) {
-                    const glm::dvec3 even = mean[2 * step + 2] - mean[2 * step], odd = mean[2 * step + 3] - mean[2 * step + 1];
-                    products[step] += glm::dot(even, odd);
-                    // the product's variance where no bias is, from the halves' difference (free of
-                    // the bias, which both share: a product's own square is not, and the shared box's
-                    // bias sits in a few texels whose squares would cancel it); per channel alike
-                    const double spread = glm::dot(even - odd, even - odd) / 2.0;
-                    variances[step] += spread * spread / 3.0;
-                }
-                ++texels;
+                if (complete)
+                    steps.push_back({mean[2] - mean[0], mean[3] - mean[1], mean[4] - mean[2], mean[5] - mean[3]});
             }
-    if (texels == 0) return;
-    // Where there is little bias to find, a sum is mostly the probe's noise,
-    // and its root (clipped at 0) reads that noise as a bias (mixed_lighting at
-    // 256 directions, K = 4: 1.1 % with a bake's noise of 1.2 % and an error of
-    // 0.9 %). So each is shrunk by its own variance, S (1 - V / S^2): S where it
-    // stands far above its noise, 0 where it stands within it.
-    double shrunk[2];
-    for (int step = 0; step < 2; ++step)
-        shrunk[step] = products[step] > 0 ? std::max(0.0, products[step] - variances[step] / products[step]) : 0.0;
-    // The order p of the bias in the texel's side h, from how it grows over the
-    // second step: D2 / D1 = k^p (2^p - 1) / (k^p - 1), = 2^p at k = 2 (k = 4:
-    // x^2 / (x + 1) with x = 2^p), p held to [1, 2]: a light that steps within a
-    // texel (the slot's rim) errs as h, smooth light as h^2 (mixed_lighting's
-    // sun-lit floor, whose coarser reads lose its shadows' steps: p = 1 read it
-    // 2x its error).
-    const double growth = shrunk[0] > 0 ? std::sqrt(shrunk[1] / shrunk[0]) : 2.0;
-    const double x = std::clamp(k == 2 ? growth : (growth + std::sqrt(growth * growth + 4.0 * growth)) / 2.0, 2.0, 4.0);
-    const double kp = k == 2 ? x : x * x;  // k^p
-    // the bias's mean square a channel, in the radiance unit of noiseMean
-    const double bias = std::sqrt(shrunk[0] / (3.0 * double(texels))) / (kp - 1.0);
-    stats.noiseResolution = bias / noiseMean;
-    stats.resolutionOrder = std::log2(x);
+    if (steps.empty()) return;
+    const ResolutionBias bias = richardsonBias(steps, k);
+    stats.noiseResolution = std::sqrt(bias.meanSquare) / noiseMean;
+    stats.resolutionOrder = bias.order;
+    stats.resolutionPastRange = bias.pastRange;
     stats.resolutionProbeDirections = directionsToProbe;
     glFinish();
     stats.secondsTiling = tilingBefore;
     stats.secondsProbe = secondsSince(t0);
+}
+
+ResolutionBias richardsonBias(std::span<const ProbeSteps> texels, int k) {
+    // Per texel and half: in range, and the factor 1 / (k^p - 1) its first step's
+    // product takes to the baked reads' bias. The second step's growth over the
+    // first, D2 / D1 = k^p (2^p - 1) / (k^p - 1), = 2^p at k = 2 (at k = 4, x^2 /
+    // (x + 1) with x = 2^p), p held to [1, 2]: a light that steps within a texel
+    // (a shadow's edge) errs as h, smooth light as h^2.
+    const auto extrapolation = [k](const glm::dvec3& first, const glm::dvec3& second, double& p) {
+        const double a = glm::dot(first, first), b = glm::dot(second, second);
+        if (a <= 0.0 || b < a) return 0.0;  // past the range (or no step): none
+        const double growth = std::sqrt(b / a);
+        const double x = std::clamp(k == 2 ? growth : (growth + std::sqrt(growth * growth + 4.0 * growth)) / 2.0, 2.0, 4.0);
+        p = std::log2(x);
+        return 1.0 / ((k == 2 ? x : x * x) - 1.0);
+    };
+    double sum = 0, variance = 0, orderSum = 0, orderWeight = 0, changed = 0, past = 0;
+    for (const ProbeSteps& t : texels) {
+        const double product = glm::dot(t.firstEven, t.firstOdd);
+        // the product's variance where no bias is, from the halves' difference (free of
+        // the bias, which both share: a product's own square is not); per channel alike
+        const glm::dvec3 apart = t.firstEven - t.firstOdd;
+        const double spread = glm::dot(apart, apart) / 2.0, productVariance = spread * spread / 3.0;
+        for (const auto& [first, second] : {std::pair{t.firstEven, t.secondEven}, std::pair{t.firstOdd, t.secondOdd}}) {
+            double p = 0;
+            const double f = extrapolation(first, second, p);
+            sum += 0.5 * product * f * f;
+            variance += 0.25 * productVariance * f * f * f * f;
+            if (f > 0.0 && product > 0.0) {
+                orderSum += p * product * f * f;
+                orderWeight += product * f * f;
+            }
+            changed += 0.5 * std::max(product, 0.0);
+            if (f == 0.0) past += 0.5 * std::max(product, 0.0);
+        }
+    }
+    ResolutionBias bias;
+    // Where there is little bias to find the sum is mostly the probe's noise, and
+    // its root (clipped at 0) would read that noise as a bias (mixed_lighting at
+    // 256 directions, K = 4: 1.1 % with a bake's noise of 1.2 % and an error of
+    // 0.9 %). So it is shrunk by its own variance, S (1 - V / S^2): S where it
+    // stands far above its noise, 0 where it stands within it.
+    const double shrunk = sum > 0 ? std::max(0.0, sum - variance / sum) : 0.0;
+    bias.meanSquare = texels.empty() ? 0.0 : shrunk / (3.0 * double(texels.size()));
+    bias.order = orderWeight > 0 ? orderSum / orderWeight : 0.0;
+    bias.pastRange = changed > 0 ? past / changed : 0.0;
+    return bias;
 }
 
 }  // namespace bb
