@@ -540,8 +540,9 @@ def write_outputs(name, cfg, rows, ref_note, ref_seconds, measured=None):
                  "truth, which the raw ratio pulls toward 1 where both near that floor. Own noise estimate: bundlebake's stats.json noise.relative, from the even and "
                  "odd directions without a reference, and the bounces still to come (noise.lag; tables measured before "
                  "2026-12-05 09:40 hold the noise only); it falls short of rel_rmse by the other biases. Resolution "
-                 "probe: noise.resolution, the bias of reading light a texel at a time (since 2026-12-06; an upper "
-                 "estimate where charts are about a texel wide), and both / error: noise.error_estimate, the two "
+                 "probe: noise.resolution, the bias of reading light a texel at a time, from the detail the baked texels "
+                 "hold (since 2026-12-06; texel by texel from 2026-12-06 06:00, before which it was summed at p = 1 "
+                 "and read high where charts are about a texel wide), and both / error: noise.error_estimate, the two "
                  "added in quadrature, over the error. Less "
                  "the reference's noise: sqrt(rel_rmse^2 - its noise^2), the bake's error against the truth (the two "
                  "are independent); estimate / error is the estimate over it (the goal: within 1.5x either way).")

@@ -104,11 +104,11 @@ struct BakeOptions {
     // (BakeStats::supersample says which).
     int supersample = 1;
     // The resolution probe (bake/resolution_probe.cpp), after the last
-    // direction of a supersampled bake: this many directions gathered twice,
-    // reading the radiance at the baked texels and at twice their size, whose
-    // difference estimates the bias of reading light at the light map's
-    // resolution (BakeStats::noiseResolution). 0: none; -1: the directions /
-    // 64, at least 8, from 256 directions on.
+    // direction of a supersampled bake: this many directions gathered three
+    // times, reading the radiance at the baked texels, the output's and twice
+    // the output's, whose differences estimate the bias of reading light at
+    // the light map's resolution (BakeStats::noiseResolution). 0: none; -1:
+    // the directions / 64, at least 8, from 256 directions on.
     int resolutionProbe = 0;
 };
 
