@@ -30,9 +30,10 @@
 // and left out (taken with p = 1 they put the error estimate at 2.9x the
 // canyon's error and 2.3x mixed_lighting's at 4096 directions, and matched the
 // shared Cornell box's slot rim only by chance: its error sits in texels whose
-// steps are small). Light that changes within a baked texel's part (the slot's panel
-// within millimetres of its edge) it cannot see at all: that needs a finer
-// bake, not coarser reads (design notes, "The resolution probe").
+// steps are small). Light that changes within a baked texel's part (the
+// slot's panel within millimetres of its edge) it cannot see at all: that
+// needs a finer bake, not coarser reads (design notes, "The resolution
+// probe").
 #include <algorithm>
 #include <cmath>
 
@@ -290,17 +291,21 @@ ResolutionBias richardsonBias(std::span<const ProbeSteps> texels, int k) {
         // the bias, which both share: a product's own square is not); per channel alike
         const glm::dvec3 apart = t.firstEven - t.firstOdd;
         const double spread = glm::dot(apart, apart) / 2.0, productVariance = spread * spread / 3.0;
+        // the texel's factor: its halves' mean, each half's 0 past the range
+        double weight = 0, order = 0;
         for (const auto& [first, second] : {std::pair{t.firstEven, t.secondEven}, std::pair{t.firstOdd, t.secondOdd}}) {
             double p = 0;
             const double f = extrapolation(first, second, p);
-            sum += 0.5 * product * f * f;
-            variance += 0.25 * productVariance * f * f * f * f;
-            if (f > 0.0 && product > 0.0) {
-                orderSum += p * product * f * f;
-                orderWeight += product * f * f;
-            }
-            changed += 0.5 * std::max(product, 0.0);
+            weight += 0.5 * f * f;
+            order += 0.5 * f * f * p;
             if (f == 0.0) past += 0.5 * std::max(product, 0.0);
+        }
+        sum += product * weight;
+        variance += productVariance * weight * weight;
+        changed += std::max(product, 0.0);
+        if (product > 0.0) {
+            orderSum += product * order;
+            orderWeight += product * weight;
         }
     }
     ResolutionBias bias;
