@@ -81,9 +81,10 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
         ->capture_default_str();
     addSupersampleOption(cmd, a.supersample);
     cmd.add_option("--resolution-probe", a.resolutionProbe,
-                   "Directions gathered again at the end of a supersampled bake, reading its light at twice the texel, "
-                   "to estimate the error of the light map's resolution (stats.json noise.resolution; -1 = directions "
-                   "/ 64, at least 8, from 256 directions on; 0 = off)")
+                   "Directions gathered again at the end of a supersampled bake, reading its light at coarser texels, "
+                   "to estimate the error of the light map's resolution where the baked texels hold the light's "
+                   "detail (stats.json noise.resolution; -1 = directions / 64, at least 8, from 256 directions on; "
+                   "0 = off)")
         ->check(CLI::Range(-1, 1 << 16))
         ->capture_default_str();
     cmd.add_option("--target-noise", a.targetNoise,
