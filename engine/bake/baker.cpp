@@ -53,6 +53,12 @@ void chartNeighbourBits(const std::vector<uint8_t>& codes, const std::vector<int
         }
 }
 
+void ownerChartCodes(const std::vector<int32_t>& owner, const std::vector<uint32_t>& chart, std::vector<uint16_t>& codes) {
+    codes.resize(owner.size());
+    for (size_t i = 0; i < owner.size(); ++i)
+        codes[i] = uint16_t(owner[i] < 0 ? TEXEL_CHART_MASK : chart[size_t(owner[i])] & TEXEL_CHART_MASK);
+}
+
 namespace {
 
 // One page of dilation codes (glsl/shared/bundle_layout.h), in place: covered
@@ -459,8 +465,7 @@ void Baker::Impl::coveragePass() {
         for (size_t i = 0; i < codes.size(); ++i) stats.partialTexels += partial[i] && codes[i] == DILATION_SELF;
         for (const CurvedTexel& c : curved[size_t(p)]) stats.exactFootprintTexels += c.exact;
         chartNeighbourBits(codes, owners, charts, res, neighbours);
-        for (size_t i = 0; i < owners.size(); ++i)
-            ownerCharts[i] = uint16_t(owners[i] < 0 ? TEXEL_CHART_MASK : charts[size_t(owners[i])] & TEXEL_CHART_MASK);
+        ownerChartCodes(owners, charts, ownerCharts);
         for (const CurvedTexel& c : curved[size_t(p)]) ownerCharts[c.texel] |= TEXEL_CURVED;
         gl::writeTexture(texelCharts.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_SHORT, 2, ownerCharts.data());
         stats.sharedTexels += texels.shared;

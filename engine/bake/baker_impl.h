@@ -25,6 +25,8 @@ namespace bb {
 // coverage codes (before dilation) and texel owners (baker.cpp).
 void chartNeighbourBits(const std::vector<uint8_t>& codes, const std::vector<int32_t>& owner,
                         const std::vector<uint32_t>& chart, int res, std::vector<uint8_t>& bits);
+// One page's texelCharts codes: each texel's owner's chart, TEXEL_CHART_MASK where none owns it (baker.cpp).
+void ownerChartCodes(const std::vector<int32_t>& owner, const std::vector<uint32_t>& chart, std::vector<uint16_t>& codes);
 
 struct Baker::Impl {
     BakeOptions options;

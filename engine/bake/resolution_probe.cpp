@@ -122,7 +122,7 @@ void Baker::Impl::probeResolution() {
         to.values.assign(size_t(layers), std::vector<glm::vec3>(size_t(r) * r));
         parallelFor(size_t(pages), [&](size_t p) { to.owners[p] = texelOwners(mesh, int(p), r); });
         std::vector<uint8_t> neighbours(size_t(r) * r);
-        std::vector<uint16_t> ownerCharts(size_t(r) * r);
+        std::vector<uint16_t> ownerCharts;
         for (int p = 0; p < pages; ++p) {
             const std::vector<int32_t>& owners = to.owners[size_t(p)];
             std::vector<uint8_t>& codes = to.codes[size_t(p)];
@@ -131,8 +131,7 @@ void Baker::Impl::probeResolution() {
                     if (from.codes[size_t(p)][size_t(y) * from.res + x] == DILATION_SELF)
                         codes[size_t(y / factor) * r + size_t(x / factor)] = DILATION_SELF;
             chartNeighbourBits(codes, owners, charts, r, neighbours);
-            for (size_t i = 0; i < ownerCharts.size(); ++i)
-                ownerCharts[i] = uint16_t(owners[i] < 0 ? TEXEL_CHART_MASK : charts[size_t(owners[i])] & TEXEL_CHART_MASK);
+            ownerChartCodes(owners, charts, ownerCharts);
             gl::writeTexture(to.charts.id(), 0, 0, p, r, r, 1, GL_RED_INTEGER, GL_UNSIGNED_SHORT, 2, ownerCharts.data());
             gl::writeTexture(to.neighbours.id(), 0, 0, p, r, r, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1, neighbours.data());
             // the weights of `from`'s texels in `to`'s: the reduction's from the baked
