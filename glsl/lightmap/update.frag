@@ -238,6 +238,12 @@ float ownCrossing(OwnSurface own, ivec2 pixel, vec2 offset) {
     return self;
 }
 
+// Columns: pixels of side `pixel` per texel of offset along the light map's x and y.
+mat2 pixelsFromOffset(vec3 positionDx, vec3 positionDy, float pixel) {
+    return mat2(vec2(dot(positionDx, bundleU), dot(positionDx, bundleV)),
+                vec2(dot(positionDy, bundleU), dot(positionDy, bundleV))) / pixel;
+}
+
 // Which pixel's ray a texel's sample takes (issue 11). A sample at a point x of
 // the footprint, read along the ray of the pixel x lies in, sees from where
 // that ray crosses the surface, up to half a pixel from x: the footprint is
@@ -272,9 +278,7 @@ float ownCrossing(OwnSurface own, ivec2 pixel, vec2 offset) {
 bool footprintPixel(vec2 centre, vec3 positionDx, vec3 positionDy, vec3 bary, vec3 baryDx, vec3 baryDy, uint flags,
                     uvec3 onChart, uint seed, out vec2 offset, out float weight) {
     weight = 1.0;
-    // columns: pixels per texel of offset along the light map's x and y
-    mat2 G = mat2(vec2(dot(positionDx, bundleU), dot(positionDx, bundleV)),
-                  vec2(dot(positionDy, bundleU), dot(positionDy, bundleV))) / pixelSize;
+    mat2 G = pixelsFromOffset(positionDx, positionDy, pixelSize);
     vec2 halfExtent = 0.5 * (abs(G[0]) + abs(G[1]));
     ivec2 lo = ivec2(ceil(centre - halfExtent - 0.5)), hi = ivec2(floor(centre + halfExtent - 0.5));
     ivec2 span = max(hi - lo + 1, ivec2(0));
@@ -299,6 +303,49 @@ bool footprintPixel(vec2 centre, vec3 positionDx, vec3 positionDy, vec3 bary, ve
     if (expected < 1.0) weight = float(crossings) / expected;
     return found;
 }
+
+#ifdef SUN_PASS
+// The sun's sample of a flat texel: a pixel centre's crossing inside the
+// footprint, its ray through the sample itself (nothing blurs a shadow's edge
+// into or out of the texel). The leaf that holds the pass's footprint point
+// takes the sample (any leaf the footprint reaches: a texel's parts in each
+// leaf by their area). In its grid, a point x uniform over the footprint's
+// square widened by a pixel's cell each way lies in the cell of any one
+// centre inside the square with the same chance (the whole cell lies in the
+// widened square), so the centre of x's cell, taken where it lies on the
+// chart and in the leaf, is uniform over the centres there; up to 8 points
+// (R2's, then hashed). Until 2026-12-06 the sample was the footprint's own
+// point, read along its pixel's ray and spread over the texel less half a
+// pixel each way (or, where the footprint spans up to 6 x 6 pixels, one of
+// the centres in it), taken by the leaf of the texel's centre alone: a band a
+// pixel wide along the texel's edges weighed half and a texel's parts in
+// another leaf nothing, a bias the passes did not lower and the noise
+// estimate could not see (mixed_lighting's floor: shadow edges up to 5 %
+// off, 0.27 % rms over its interior texels with 16 x 16 passes; 0.09-0.12 %
+// now, two seeds). 1: taken (offset: the crossing, texels from the centre),
+// 0: another leaf's, -1: none found (the sun along the surface, a footprint
+// far off its square: footprintOffset's point instead).
+int sunCrossing(FlatFrame f, uvec3 onChart, out vec2 offset) {
+    offset = footprintCandidate(footprintSample, 0, uvec2(0u));
+    if (!takeLeaf(rootFromBundle(bundleFromWorld(f.position + f.positionDx * offset.x + f.positionDy * offset.y).xy)))
+        return 0;
+    mat2 G = pixelsFromOffset(f.positionDx, f.positionDy, pixelSize);
+    if (abs(determinant(G)) < 1e-6) return -1;
+    mat2 offsetFromPixel = inverse(G);
+    vec2 widened = 1.0 + abs(offsetFromPixel[0]) + abs(offsetFromPixel[1]);
+    vec2 centre = gridFromRoot(rootFromBundle(bundleFromWorld(f.position).xy));
+    for (int attempt = 0; attempt < 8; ++attempt) {
+        vec2 pixel = floor(centre + G * (footprintCandidate(footprintSample, attempt, uvec2(0u)) * widened)) + 0.5;
+        vec2 o = offsetFromPixel * (pixel - centre);
+        if (any(greaterThan(abs(o), vec2(0.5))) || any(lessThan(pixel, vec2(0.0))) ||
+            any(greaterThan(pixel, vec2(leafPixels))) || offChart(f.bary, f.baryDx, f.baryDy, f.flags, onChart, o))
+            continue;
+        offset = o;
+        return 1;
+    }
+    return -1;
+}
+#endif
 
 // One sample of a texel for this pass: its footprint point, the shading
 // normal there, its triangle's plane (ng: the side the bundle pass gives the
@@ -328,36 +375,32 @@ bool planeSample(FlatFrame f, ivec3 texel, vec3 leafPoint, out TexelSample s) {
     // this texel's size on the surface (one step of the light map raster)
     s.texelSize = max(length(f.positionDx), length(f.positionDy));
     s.texel = texel;
+    s.weight = 1.0;
+    vec2 jitter;
+    uvec3 onChart = texelFetch(footprint, s.texel, 0).rgb;
+#ifdef SUN_PASS
+    int taken = sunCrossing(f, onChart, jitter);
+    if (taken == 0) return false;
+    if (taken < 0) {
+        // none found: the footprint's point, read along its pixel's ray up to
+        // half a pixel beside it, spread over the texel less that so that the
+        // two stay in it (a pixel wider than the texel: the pixel's jitter
+        // alone spreads the samples)
+        jitter = footprintOffset(f.bary, f.baryDx, f.baryDy, f.flags, onChart, footprintSample);
+        float facing = length(faceNormal) > 0.0 ? abs(dot(normalize(faceNormal), bundleDir)) : 1.0;
+        jitter *= clamp(1.0 - pixelSize / (max(facing, 1e-3) * max(s.texelSize, 1e-30)), 0.0, 1.0);
+    }
+#else
     // the leaf of the texel's centre takes its sample (a sample whose point
     // lies in another leaf is lost, at random: leaves move with d)
     if (!takeLeaf(rootFromBundle(bundleFromWorld(leafPoint).xy))) return false;
     vec2 centreRoot = rootFromBundle(bundleFromWorld(f.position).xy);
-#ifdef SUN_PASS
-    // which of the pixel centres in the footprint: another with each seed (the
-    // sun's grid is the same for every seed, bakeSun)
-    uint pixelSeed = pcgHash((footprintSample + 0x632be5abu) ^ FOOTPRINT_SHIFT.y);
-#else
-    uint pixelSeed = pcgHash(randomSeed);
-#endif
-    vec2 jitter;
-    uvec3 onChart = texelFetch(footprint, s.texel, 0).rgb;
     if (!footprintPixel(gridFromRoot(centreRoot), f.positionDx, f.positionDy, f.bary, f.baryDx, f.baryDy, f.flags,
-                        onChart, pixelSeed, jitter, s.weight)) {
-#ifndef SUN_PASS
+                        onChart, pcgHash(randomSeed), jitter, s.weight)) {
         if (s.weight == 0.0) return false;  // a grazing direction no pixel centre crossed the footprint in
-#endif
         jitter = footprintOffset(f.bary, f.baryDx, f.baryDy, f.flags, onChart, footprintSample);
-#ifdef SUN_PASS
-        // The sun's sample is where its pixel's ray meets the surface: the pixel
-        // (jittered from run to run, bakeSun) spreads it too, by up to half a
-        // pixel from the footprint's point. The point is spread over the texel
-        // less that, so the two together stay within the texel: a shadow edge
-        // along its border stays out of it. Where a pixel covers more than a
-        // texel (a grazing sun), the pixel's jitter alone spreads the samples.
-        float facing = length(faceNormal) > 0.0 ? abs(dot(normalize(faceNormal), bundleDir)) : 1.0;
-        jitter *= clamp(1.0 - pixelSize / (max(facing, 1e-3) * max(s.texelSize, 1e-30)), 0.0, 1.0);
-#endif
     }
+#endif
     s.position = f.position + f.positionDx * jitter.x + f.positionDy * jitter.y;
     s.anchor = leafPoint;
     // the shading normal where the point leaves the triangle, not extrapolated
