@@ -581,6 +581,9 @@ Status Baker::Impl::init(const Scene& scene) {
     inputKey = hashInputs(scene);
     stats.directionsTotal = options.directions;
     if (options.directions < 1) return Status::error("--directions must be at least 1");
+    // the sun's sample count is the direct map's fp16 alpha, exact to 2048 (45^2 = 2025)
+    if (options.sunJitter < 0 || options.sunJitter > kMaxSunJitter)
+        return Status::error("--sun-jitter must be 0 to " + std::to_string(kMaxSunJitter));
     if (options.share && (options.share->count() < 1 || options.share->index() < 0 ||
                           options.share->index() >= options.share->count()))
         return Status::error("a direction share needs 0 <= index < count");

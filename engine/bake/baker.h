@@ -115,6 +115,9 @@ struct BakeOptions {
 // The resolution probe's directions for `options` (0: none).
 int resolutionProbeDirections(const BakeOptions& options);
 
+// The most sun passes per axis: a texel's sample count is held in fp16 (exact to 2048).
+constexpr int kMaxSunJitter = 45;
+
 // The sun's passes per axis for `options`: sunJitter, or from the directions
 // sqrt(directions / 16) in [2, 16], so that the shadow edges' error falls
 // with the bundles' (mixed_lighting stopped at 6.5 % with 4). The cap was 8

@@ -198,7 +198,7 @@ void Baker::Impl::bakeSun() {
                 const glm::vec2 jitter((jx + 0.5f) / j - 0.5f, (jy + 0.5f) / j - 0.5f);
                 footprintSample = uint32_t(jy * j + jx);
                 oddSample = footprintSample % 2 == 1;
-                // each sun's seeds apart from the next's (--sun-jitter is at most 64: 4096 passes)
+                // each sun's seeds apart from the next's (--sun-jitter is at most 45: 2025 passes)
                 tracer->run(bundleFrame(glm::normalize(lights[li].direction), jitter, sunOptions.uniform, jitterUnit),
                             sunOptions, uint32_t(li * 4096 + jy * j + jx), false, update, options.leafRuns);
             }

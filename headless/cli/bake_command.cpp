@@ -77,7 +77,7 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
         ->capture_default_str();
     cmd.add_option("--sun-jitter", a.sunJitter,
                    "Sun passes per axis, each at another point of every texel's footprint (0 = from the directions)")
-        ->check(CLI::Range(0, 64))
+        ->check(CLI::Range(0, kMaxSunJitter))
         ->capture_default_str();
     addSupersampleOption(cmd, a.supersample);
     cmd.add_option("--resolution-probe", a.resolutionProbe,

@@ -61,6 +61,19 @@ TEST(CliBakeErrors, BadSkyValue) {
     }
 }
 
+// More sun passes than a texel's fp16 sample count holds (45 a side: 2025 of
+// 2048) are refused: at 64 a side (4096 passes) the count stopped at 2048 and
+// a lit texel read twice its light.
+TEST(CliBakeErrors, SunJitterPastTheSampleCount) {
+    TempDir tmp("sun-jitter");
+    ASSERT_TRUE(tmp.ok());
+    CliResult r = runCli({"bake", furnace(), "-o", tmp / "out", "--backend", "osmesa", "--uv-layout", "asset",
+                          "--resolution", "16", "--directions", "4", "--sun-jitter", "46"},
+                         tmp);
+    expectOneErrorLine(r, "--sun-jitter");
+    EXPECT_EQ(filesIn(tmp.path() / "out"), 0u) << "nothing may be written for bad input";
+}
+
 TEST(CliBakeErrors, UnwritableOutputDir) {
     TempDir tmp("unwritable");
     ASSERT_TRUE(tmp.ok());
