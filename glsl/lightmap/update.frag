@@ -439,12 +439,20 @@ bool curvedSample(out TexelSample s) {
         return planeSample(curvedFlatFrame(vCurved), texel, curvedTexelCentre(vCurved), s);
     }
     s.texel = texel;
+#ifndef SUN_PASS
     // the leaf of the texel's centre takes its sample, as on flat texels
     if (!takeLeaf(rootFromBundle(bundleFromWorld(curvedTexelCentre(vCurved)).xy))) return false;
+#endif
     vec2 point;
     CurvedTriangle tri;
     curvedFootprintPoint(vCurved, texelFetch(footprint, s.texel, 0).xy, footprintSample, point, tri);
     s.position = curvedTrianglePosition(tri, point);
+#ifdef SUN_PASS
+    // the leaf the point lies in (the sun's leaves stay put from pass to pass:
+    // the centre's would drop the texel's parts in another leaf every time, as
+    // sunCrossing says of flat texels)
+    if (!takeLeaf(rootFromBundle(bundleFromWorld(s.position).xy))) return false;
+#endif
     s.anchor = s.position;
     s.n = normalize(curvedTriangleNormal(tri, point));
     s.ng = tri.faceNormal.xyz;
