@@ -244,6 +244,12 @@ mat2 pixelsFromOffset(vec3 positionDx, vec3 positionDy, float pixel) {
                 vec2(dot(positionDy, bundleU), dot(positionDy, bundleV))) / pixel;
 }
 
+// Whether a pixel centre's crossing `o` texels from the texel's centre lies
+// off its footprint: outside its square, or off its chart (offChart).
+bool offFootprint(vec2 o, vec3 bary, vec3 baryDx, vec3 baryDy, uint flags, uvec3 onChart) {
+    return any(greaterThan(abs(o), vec2(0.5))) || offChart(bary, baryDx, baryDy, flags, onChart, o);
+}
+
 // Which pixel's ray a texel's sample takes (issue 11). A sample at a point x of
 // the footprint, read along the ray of the pixel x lies in, sees from where
 // that ray crosses the surface, up to half a pixel from x: the footprint is
@@ -290,7 +296,7 @@ bool footprintPixel(vec2 centre, vec3 positionDx, vec3 positionDy, vec3 bary, ve
     for (int y = lo.y; y <= hi.y; ++y)
         for (int x = lo.x; x <= hi.x; ++x) {
             vec2 o = offsetFromPixel * (vec2(x, y) + 0.5 - centre);
-            if (any(greaterThan(abs(o), vec2(0.5))) || offChart(bary, baryDx, baryDy, flags, onChart, o)) continue;
+            if (offFootprint(o, bary, baryDx, baryDy, flags, onChart)) continue;
             uint h = pcgHash(seed ^ (uint(x) * 0x9e3779b1u) ^ (uint(y) * 0x85ebca77u));
             ++crossings;
             if (!found || h > best) {
@@ -326,8 +332,9 @@ bool footprintPixel(vec2 centre, vec3 positionDx, vec3 positionDy, vec3 bary, ve
 // 0: another leaf's, -1: none found (the sun along the surface, a footprint
 // far off its square: footprintOffset's point instead).
 int sunCrossing(FlatFrame f, uvec3 onChart, out vec2 offset) {
-    offset = footprintCandidate(footprintSample, 0, uvec2(0u));
-    if (!takeLeaf(rootFromBundle(bundleFromWorld(f.position + f.positionDx * offset.x + f.positionDy * offset.y).xy)))
+    vec2 first = footprintCandidate(footprintSample, 0, uvec2(0u));
+    offset = vec2(0.0);
+    if (!takeLeaf(rootFromBundle(bundleFromWorld(f.position + f.positionDx * first.x + f.positionDy * first.y).xy)))
         return 0;
     mat2 G = pixelsFromOffset(f.positionDx, f.positionDy, pixelSize);
     if (abs(determinant(G)) < 1e-6) return -1;
@@ -335,10 +342,11 @@ int sunCrossing(FlatFrame f, uvec3 onChart, out vec2 offset) {
     vec2 widened = 1.0 + abs(offsetFromPixel[0]) + abs(offsetFromPixel[1]);
     vec2 centre = gridFromRoot(rootFromBundle(bundleFromWorld(f.position).xy));
     for (int attempt = 0; attempt < 8; ++attempt) {
-        vec2 pixel = floor(centre + G * (footprintCandidate(footprintSample, attempt, uvec2(0u)) * widened)) + 0.5;
+        vec2 x = attempt == 0 ? first : footprintCandidate(footprintSample, attempt, uvec2(0u));
+        vec2 pixel = floor(centre + G * (x * widened)) + 0.5;
         vec2 o = offsetFromPixel * (pixel - centre);
-        if (any(greaterThan(abs(o), vec2(0.5))) || any(lessThan(pixel, vec2(0.0))) ||
-            any(greaterThan(pixel, vec2(leafPixels))) || offChart(f.bary, f.baryDx, f.baryDy, f.flags, onChart, o))
+        if (any(lessThan(pixel, vec2(0.0))) || any(greaterThan(pixel, vec2(leafPixels))) ||
+            offFootprint(o, f.bary, f.baryDx, f.baryDy, f.flags, onChart))
             continue;
         offset = o;
         return 1;
