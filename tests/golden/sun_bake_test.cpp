@@ -343,6 +343,20 @@ Expected<BoxShadow> boxShadow(int spp) {
     return b;
 }
 
+// A bake of the box's shadow with `bo`: its error against the box's reference
+// and its stats (the noise estimate).
+struct BoxBake {
+    double error = 0.0;
+    BakeStats stats;
+};
+Expected<BoxBake> bakeBox(const BoxShadow& box, const BakeOptions& bo) {
+    BoxBake b;
+    auto gpu = bakeGpu(box.scene, box.layout, bo, nullptr, &b.stats);
+    if (!gpu) return Expected<BoxBake>::failure(gpu.error());
+    b.error = compareMaps(*gpu, box.reference).relativeRmse();
+    return b;
+}
+
 TEST(SunBake, NoiseEstimateHoldsTheSunsError) {
     BB_REQUIRE_GL();
     auto box = boxShadow(4096);
@@ -350,15 +364,14 @@ TEST(SunBake, NoiseEstimateHoldsTheSunsError) {
     BakeOptions bo = blackOptions();
     bo.directions = 16;
     bo.sunJitter = 4;
-    BakeStats stats;
-    auto gpu = bakeGpu(box->scene, box->layout, bo, nullptr, &stats);
-    ASSERT_TRUE(gpu) << gpu.error();
-    EXPECT_EQ(stats.sunJitter, 4);
-    const double error = compareMaps(*gpu, box->reference).relativeRmse();
+    auto bake = bakeBox(*box, bo);
+    ASSERT_TRUE(bake) << bake.error();
+    EXPECT_EQ(bake->stats.sunJitter, 4);
+    const double error = bake->error;
     std::printf("[sun] 4 x 4 passes: error %.4f against the reference, estimate %.4f (direct %.4f)\n", error,
-                stats.noiseRelative, stats.noiseDirect);
-    EXPECT_GE(stats.noiseRelative, error / 1.5) << "the estimate is too low";
-    EXPECT_LE(stats.noiseRelative, error * 1.5) << "the estimate is too high";
+                bake->stats.noiseRelative, bake->stats.noiseDirect);
+    EXPECT_GE(bake->stats.noiseRelative, error / 1.5) << "the estimate is too low";
+    EXPECT_LE(bake->stats.noiseRelative, error * 1.5) << "the estimate is too high";
 }
 
 // Two seeds' bakes of the box's shadow differ by the sun's error: the
@@ -416,11 +429,6 @@ TEST(SunBake, PassesGrowWithTheDirectionsAndLowerTheError) {
     EXPECT_LT(error[1], 0.8 * error[0]);
 }
 
-}  // namespace
-}  // namespace bb::test
-
-namespace bb::test {
-namespace {
 
 // Where the sun's pixels are far finer than a texel (a scene's finest texels
 // set them: mixed_lighting's chair beside its floor) each pass takes a pixel
@@ -442,15 +450,14 @@ TEST(SunBake, FinePixelsSampleTheFootprintEvenly) {
     bo.directions = 16;
     bo.bundleResolution = 768;
     bo.sunJitter = 16;
-    BakeStats stats;
-    auto gpu = bakeGpu(box->scene, box->layout, bo, nullptr, &stats);
-    ASSERT_TRUE(gpu) << gpu.error();
-    const double error = compareMaps(*gpu, box->reference).relativeRmse();
+    auto bake = bakeBox(*box, bo);
+    ASSERT_TRUE(bake) << bake.error();
+    const double error = bake->error;
     std::printf("[sun] pixels an eighth of a texel, 16 x 16 passes: error %.4f against the reference, estimate %.4f\n",
-                error, stats.noiseRelative);
+                error, bake->stats.noiseRelative);
     EXPECT_LT(error, 0.0040);
-    EXPECT_GE(stats.noiseRelative, error / 1.5) << "the estimate misses part of the error";
-    EXPECT_LE(stats.noiseRelative, error * 1.5);
+    EXPECT_GE(bake->stats.noiseRelative, error / 1.5) << "the estimate misses part of the error";
+    EXPECT_LE(bake->stats.noiseRelative, error * 1.5);
 }
 
 }  // namespace
