@@ -42,10 +42,13 @@ int autoSupersample(const BakeMesh& mesh, const std::vector<uint32_t>& charts, c
 }
 
 namespace {
-// A 4 x 4 bake's owners, from the half-size texels' (halfTexelOwners at res)
+// A 4 x 4 bake's owners: halfTexelOwners at 2 res, each half-size texel's
+// texel's owner (`coarse`, at res) standing for its own
 std::vector<int32_t> quarterTexelOwners(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res,
-                                        const std::vector<int32_t>& half, std::vector<uint8_t>* partial = nullptr) {
-    return halfTexelOwners(mesh, charts, page, 2 * res, partial, &half);
+                                        const std::vector<int32_t>& coarse, std::vector<uint8_t>* partial = nullptr) {
+    std::vector<int32_t> up(size_t(4) * coarse.size());
+    for (size_t i = 0; i < up.size(); ++i) up[i] = coarse[(i / size_t(2 * res)) / 2 * size_t(res) + (i % size_t(2 * res)) / 2];
+    return halfTexelOwners(mesh, charts, page, 2 * res, partial, &up);
 }
 }  // namespace
 
@@ -54,60 +57,38 @@ std::vector<int32_t> fineTexelOwners(const BakeMesh& mesh, const std::vector<uin
     CHECK(k == 1 || k == 2 || k == 4);
     if (k == 1) return texelOwners(mesh, page, res, partial);
     if (k == 2) return halfTexelOwners(mesh, charts, page, res, partial);
-    return quarterTexelOwners(mesh, charts, page, res, halfTexelOwners(mesh, charts, page, res), partial);
+    return quarterTexelOwners(mesh, charts, page, res, texelOwners(mesh, page, res), partial);
 }
 
-TexelQuarters texelQuarters(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res,
-                            std::vector<int32_t> owner, const std::vector<int32_t>& fineOwner) {
-    TexelQuarters out;
-    out.owner = std::move(owner);
-    const std::vector<TexelFootprint> footprints = texelFootprints(mesh, page, res, out.owner, charts);
-    const size_t perPage = size_t(res) * res;
-    out.weights.assign(perPage, glm::vec4(0.0f));
-    for (size_t i = 0; i < perPage; ++i) {
-        if (out.owner[i] < 0) continue;
-        const int x = int(i % size_t(res)), y = int(i / size_t(res));
-        for (int q = 0; q < 4; ++q) {
-            const int32_t o = fineOwner[size_t(2 * y + q / 2) * size_t(2 * res) + size_t(2 * x + q % 2)];
-            if (o >= 0 && charts[size_t(o)] == charts[size_t(out.owner[i])])
-                out.weights[i][q] = float(footprints[i].quarters[size_t(q)]);
-        }
-    }
-    return out;
-}
-
-std::vector<float> fineTexelWeights(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res, int k) {
+std::vector<float> fineTexelWeights(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res, int k,
+                                    const std::vector<int32_t>* owners) {
     CHECK(k == 2 || k == 4);
+    const std::vector<int32_t> texels = owners ? *owners : texelOwners(mesh, page, res);
+    const std::vector<int32_t> fine =
+        k == 2 ? halfTexelOwners(mesh, charts, page, res) : quarterTexelOwners(mesh, charts, page, res, texels);
+    const std::vector<TexelFootprint> footprints = texelFootprints(mesh, page, res, texels, charts);
     const int fineRes = k * res;
-    std::vector<float> out(size_t(fineRes) * fineRes);
-    const std::vector<int32_t> half = halfTexelOwners(mesh, charts, page, res);
-    const TexelQuarters top = texelQuarters(mesh, charts, page, res, texelOwners(mesh, page, res), half);
-    TexelQuarters below;  // k = 4: each half-size texel's quarters
-    if (k == 4) below = texelQuarters(mesh, charts, page, 2 * res, half, quarterTexelOwners(mesh, charts, page, res, half));
+    std::vector<float> out(size_t(fineRes) * fineRes, 0.0f);
     for (int y = 0; y < fineRes; ++y)
         for (int x = 0; x < fineRes; ++x) {
-            const int hx = x * 2 / k, hy = y * 2 / k;  // the half-size texel it lies in
-            float w = top.weights[size_t(hy / 2) * size_t(res) + size_t(hx / 2)][(hx % 2) + 2 * (hy % 2)];
-            if (k == 4) {
-                const glm::vec4& q = below.weights[size_t(hy) * size_t(2 * res) + size_t(hx)];
-                const float sum = q.x + q.y + q.z + q.w;
-                w = sum > 0.0f ? w * q[(x % 2) + 2 * (y % 2)] / sum : 0.0f;
-            }
-            out[size_t(y) * size_t(fineRes) + size_t(x)] = w;
+            const size_t i = size_t(y / k) * size_t(res) + size_t(x / k), f = size_t(y) * size_t(fineRes) + size_t(x);
+            if (texels[i] >= 0 && fine[f] >= 0 && charts[size_t(fine[f])] == charts[size_t(texels[i])])
+                out[f] = float(footprints[i].part(k, x % k, y % k));
         }
     return out;
 }
 
 namespace {
 
-// One level of the reduction: page p of `fine` (2 res, its coverage) to res, each texel its
-// quarters' mean at `quarters`' weights; texels with none their chart's covered neighbours' mean,
-// else not covered (lost). Returns the values (w 1 where set).
-std::vector<glm::vec4> reduceLevel(const io::ImageRgb& from, const std::vector<uint8_t>& fromCovered,
-                                   const std::vector<uint32_t>& charts, int res, const TexelQuarters& quarters,
-                                   std::vector<uint8_t>& covered, LightmapPages& counts) {
+// Page `page` of a bake k x k to a texel (`from`, k res a side, its coverage)
+// to res: each texel its k x k texels' mean at `weights` (fineTexelWeights);
+// texels with none their chart's covered neighbours' mean, else not covered
+// (lost). Returns the values (w 1 where set).
+std::vector<glm::vec4> reduceTexels(const io::ImageRgb& from, const std::vector<uint8_t>& fromCovered,
+                                    const std::vector<float>& weights, const std::vector<int32_t>& owner,
+                                    const std::vector<uint32_t>& charts, int res, int k, std::vector<uint8_t>& covered,
+                                    LightmapPages& counts) {
     const size_t perPage = size_t(res) * res;
-    const std::vector<int32_t>& owner = quarters.owner;
     std::vector<glm::vec4> map(perPage, glm::vec4(0.0f));
     covered.assign(perPage, 0);
     for (size_t i = 0; i < perPage; ++i) {
@@ -115,17 +96,18 @@ std::vector<glm::vec4> reduceLevel(const io::ImageRgb& from, const std::vector<u
         if (owner[i] < 0) continue;
         glm::dvec3 sum(0.0);
         double weight = 0.0;
-        for (int q = 0; q < 4; ++q) {
-            const size_t j = size_t(2 * y + q / 2) * size_t(from.width) + size_t(2 * x + q % 2);
-            const double w = quarters.weights[i][q];
-            if (w == 0.0 || !fromCovered[j]) continue;
-            sum += glm::dvec3(from.pixels[j]) * w;
-            weight += w;
-        }
+        for (int fy = k * y; fy < k * y + k; ++fy)
+            for (int fx = k * x; fx < k * x + k; ++fx) {
+                const size_t j = size_t(fy) * size_t(from.width) + size_t(fx);
+                const double w = weights[j];
+                if (w == 0.0 || !fromCovered[j]) continue;
+                sum += glm::dvec3(from.pixels[j]) * w;
+                weight += w;
+            }
         covered[i] = 1;
         if (weight > 0.0) map[i] = glm::vec4(glm::vec3(sum / weight), 1.0f);
     }
-    // texels with no half-size texel of their own: their chart's neighbours' mean, else padding
+    // texels with no fine texel of their own: their chart's neighbours' mean, else padding
     std::vector<std::pair<size_t, glm::vec4>> fill;
     for (size_t i = 0; i < perPage; ++i) {
         if (!covered[i] || map[i].w > 0.0f) continue;
@@ -168,20 +150,11 @@ LightmapPages reduceLightmaps(const LightmapPages& fine, const BakeMesh& mesh, c
     std::vector<LightmapPages> pageCounts(size_t(layout.pageCount));  // each page's filled and lost texels
     parallelFor(size_t(layout.pageCount), [&](size_t pageIndex) {  // each page its own outputs
         const int p = int(pageIndex);
-        io::ImageRgb from = fine.pages[pageIndex];
-        std::vector<uint8_t> fromCovered = fine.covered[pageIndex], covered;
-        const std::vector<int32_t> half = halfTexelOwners(mesh, charts, p, res);
-        if (k == 4) {  // quarter-size texels to half-size ones (their counts are not the output's)
-            LightmapPages counts;
-            const TexelQuarters q = texelQuarters(mesh, charts, p, 2 * res, half, quarterTexelOwners(mesh, charts, p, res, half));
-            const std::vector<glm::vec4> map = reduceLevel(from, fromCovered, charts, 2 * res, q, covered, counts);
-            from.width = from.height = 2 * res;
-            from.pixels.resize(map.size());
-            for (size_t i = 0; i < map.size(); ++i) from.pixels[i] = glm::vec3(map[i]);
-            fromCovered = covered;
-        }
-        const TexelQuarters quarters = texelQuarters(mesh, charts, p, res, texelOwners(mesh, p, res), half);
-        std::vector<glm::vec4> map = reduceLevel(from, fromCovered, charts, res, quarters, covered, pageCounts[pageIndex]);
+        const std::vector<int32_t> owner = texelOwners(mesh, p, res);
+        std::vector<uint8_t> covered;
+        std::vector<glm::vec4> map = reduceTexels(fine.pages[pageIndex], fine.covered[pageIndex],
+                                                  fineTexelWeights(mesh, charts, p, res, k, &owner), owner, charts, res,
+                                                  k, covered, pageCounts[pageIndex]);
         out.pages[pageIndex] = dilatedImage(std::move(map), res, layout.padding + 1);
         out.covered[pageIndex] = std::move(covered);
     });

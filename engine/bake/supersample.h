@@ -5,7 +5,8 @@
 // A texel's value is the mean over its footprint, the part of its square on
 // its chart (docs/design-notes.md "Texels partly on their chart"): the mean
 // of its four half-size texels' values, each weighted by the part of the
-// texel's footprint in its quarter (TexelFootprint::quarters). Where charts
+// texel's footprint in its quarter (TexelFootprint::part; at 4 x 4 its
+// sixteen quarter-size texels', fineTexelWeights). Where charts
 // share a texel (an asset's atlas packed tighter than its texels) the fine
 // bake gives a half-size texel to the chart of the texel it lies in wherever
 // that chart holds a sixteenth of its square (halfTexelOwners): the texel's
@@ -53,30 +54,24 @@ int autoSupersample(const BakeMesh& mesh, const std::vector<uint32_t>& charts, c
 
 // The owners of a bake's texels k x k to a layout texel at resolution `res`
 // (k res of them a side): texelOwners (k 1), halfTexelOwners (2), and at 4
-// halfTexelOwners again below the half-size texels', whose owners stand for
-// their texels': each level gives its texels' charts their parts first.
+// halfTexelOwners at 2 res with each half-size texel's texel's owner standing
+// for its own: a texel's chart takes its parts of the quarter-size texels
+// first, wherever a strip took the half-size texel they lie in (a strip a
+// tenth of a texel wide ending at a wall, half of whose texel went to the
+// strip beside it, read the other half's light alone: 25-30 % dark on the
+// bench city).
 std::vector<int32_t> fineTexelOwners(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res, int k,
                                      std::vector<uint8_t>* partial = nullptr);
 
-// Page `page` of a layout at resolution `res`, as reduceLightmaps reads it,
-// from the texels' owners at res and 2 res (texelOwners and halfTexelOwners,
-// or a level of a 4 x 4 bake's: the half-size and quarter-size texels'): per
-// texel its owner and its four half-size texels' weights in it (x + 2 y, y up
-// the page): the footprint's points in each quarter, 0 where the half-size
-// texel is not of the texel's chart; all 0 for a texel not covered.
-struct TexelQuarters {
-    std::vector<int32_t> owner;
-    std::vector<glm::vec4> weights;
-};
-TexelQuarters texelQuarters(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res,
-                            std::vector<int32_t> owner, const std::vector<int32_t>& fineOwner);
-
 // Per texel of a bake k x k to a layout texel (k res a side; k 2 or 4), its
-// weight in its layout texel's value as reduceLightmaps composes it: the noise
-// estimate weighs the texels by them (Baker::Impl::estimateNoise).
-std::vector<float> fineTexelWeights(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res, int k);
+// weight in its layout texel's value as reduceLightmaps composes it: the
+// texel's footprint's points in it (TexelFootprint::part), 0 where the fine
+// texel is another chart's. The noise estimate weighs the texels by them too
+// (Baker::Impl::estimateNoise). `owners`: texelOwners at res, if at hand.
+std::vector<float> fineTexelWeights(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res, int k,
+                                    const std::vector<int32_t>* owners = nullptr);
 
-// `fine`: the light maps of a bake on supersampledLayout(layout, k), k 2 or 4 (two levels), padding
+// `fine`: the light maps of a bake on supersampledLayout(layout, k), k 2 or 4, padding
 // dilated; `mesh`: the bake's mesh (either layout's: page UVs are the same);
 // `charts`: its findLightmapCharts.
 // Returns the light maps of `layout`, with `covered` by texelOwners at its

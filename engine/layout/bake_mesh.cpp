@@ -532,14 +532,14 @@ std::vector<TexelFootprint> texelFootprints(const BakeMesh& mesh, int page, int 
             wrong += taken != bool(exact[size_t(k)]);
         }
         out[i].inexact = wrong > kInexactFootprintShare * on;
-        for (int k = 0; k < N * N; ++k) out[i].quarters[size_t((k % N) * 2 / N + (k / N) * 2 / N * 2)] += exact[size_t(k)];
+        for (int k = 0; k < N * N; ++k) out[i].sixteenths[size_t((k % N) * 4 / N + (k / N) * 4 / N * 4)] += exact[size_t(k)];
         if (out[i].inexact) out[i].area = uint8_t(std::lround(255.0 * on / (N * N)));
     }
     for (size_t i = 0; i < mask.size(); ++i) {
         out[i].cells = mask[i];
         if (owner[i] >= 0 && mask[i] == ~uint64_t(0)) {
             out[i].area = 255;
-            out[i].quarters.fill(N * N / 4);
+            out[i].sixteenths.fill(N * N / 16);
         }
     }
     return out;

@@ -156,11 +156,18 @@ struct TexelFootprint {
     // (curvedTexels, CurvedTexel::exact) and keeps the points one of its
     // triangles holds; `area` is then that part's (the grid's count).
     bool inexact = false;
-    // Points of the 32 x 32 grid on the chart in each quarter of the square
-    // (0..256; (x, y) = (0, 0), (1, 0), (0, 1), (1, 1) at index x + 2 y, y up
-    // the page): how much each of its 2 x 2 texels in a supersampled bake
-    // weighs in it (bake/supersample.h).
-    std::array<uint16_t, 4> quarters{};
+    // Points of the 32 x 32 grid on the chart in each sixteenth of the square
+    // (0..64; cell (x, y) at index x + 4 y, y up the page): how much each of
+    // its k x k texels in a supersampled bake weighs in it (part;
+    // bake/supersample.h).
+    std::array<uint8_t, 16> sixteenths{};
+    // The points in texel (x, y) of its k x k (k 1, 2 or 4)
+    int part(int k, int x, int y) const {
+        int sum = 0;
+        for (int j = y * 4 / k; j < (y + 1) * 4 / k; ++j)
+            for (int i = x * 4 / k; i < (x + 1) * 4 / k; ++i) sum += sixteenths[size_t(i + 4 * j)];
+        return sum;
+    }
 };
 constexpr double kInexactFootprintShare = 0.1;
 std::vector<TexelFootprint> texelFootprints(const BakeMesh& mesh, int page, int res, const std::vector<int32_t>& owner,

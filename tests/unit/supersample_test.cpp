@@ -1,6 +1,6 @@
 // Supersampled bakes' reduction (bake/supersample.h): a texel of the layout
-// is the mean of its 2 x 2 half-size texels, each weighted by its quarter's
-// part of the texel's footprint, over those baked on the texel's own chart.
+// is the mean of its k x k texels, each weighted by its part of the texel's
+// footprint, over those baked on the texel's own chart.
 #include <gtest/gtest.h>
 
 #include "bake/supersample.h"
@@ -37,11 +37,11 @@ TEST(Supersample, ATexelIsItsChartsHalfSizeTexelsWeightedByItsFootprint) {
     const size_t t = 2 * 8 + 4;
     ASSERT_GE(owners[t], 0);
     EXPECT_EQ(charts[size_t(owners[t])], charts[0]);
-    EXPECT_EQ(footprints[t].quarters[0], 256);
-    EXPECT_EQ(footprints[t].quarters[2], 256);
-    EXPECT_EQ(footprints[t].quarters[1], 48);
-    EXPECT_EQ(footprints[t].quarters[3], 48);
-    EXPECT_EQ(footprints[2 * 8 + 2].quarters, (std::array<uint16_t, 4>{256, 256, 256, 256}));
+    EXPECT_EQ(footprints[t].part(2, 0, 0), 256);
+    EXPECT_EQ(footprints[t].part(2, 0, 1), 256);
+    EXPECT_EQ(footprints[t].part(2, 1, 0), 48);
+    EXPECT_EQ(footprints[t].part(2, 1, 1), 48);
+    for (int q = 0; q < 16; ++q) EXPECT_EQ(footprints[2 * 8 + 2].sixteenths[size_t(q)], 64) << "a whole texel";
 
     // the fine bake: A's half-size texels read their x, B's 100 more
     LightmapPages fine;
@@ -130,6 +130,50 @@ TEST(Supersample, AQuarterSizeBakeReducesToTheMeanOverTheTexelsFootprint) {
             weight += weights[i];
         }
     EXPECT_NEAR(sum / weight, out.pages[0].pixels[t].x, 1e-3);
+}
+
+// A strip B (y 3.7..3.82, x 1..7 of an 8 x 8 page) lies only in the upper
+// half-size row of texel row 3, whose chart C (y 3.2..3.6) holds 0.1 of it; D
+// (y 3.92..6) owns the rows above. B takes half-size texels of that row from C
+// (as in HalfTexelOwners.AStripWithNoFreeHalfSizeTexelTakesOnesItsTexelsChartCanSpare),
+// so 2 x 2 leaves C's part there out of its texels' values. 4 x 4 gives C the
+// quarter-size texels it holds a sixteenth of first (row 14, y 3.5..3.75, of
+// which B holds a fifth), B's taken half-size texels or not: every texel of
+// row 3 weighs its whole footprint (its sixteenths' points), and B keeps
+// quarter-size texels above (row 15).
+TEST(Supersample, AQuarterSizeBakeWeighsTheWholeFootprintWhereAStripTookAHalfSizeTexel) {
+    BakeMesh m;
+    addPageQuad(m, {1.0f, 3.2f}, {7.0f, 3.6f}, 8.0f);
+    addPageQuad(m, {1.0f, 3.7f}, {7.0f, 3.82f}, 8.0f);
+    addPageQuad(m, {1.0f, 3.92f}, {7.0f, 6.0f}, 8.0f);
+    m.pageFirstTriangle = {0, 6};
+    const std::vector<uint32_t> charts = findLightmapCharts(m);
+    const std::vector<int32_t> owners = texelOwners(m, 0, 8);
+    const std::vector<TexelFootprint> footprints = texelFootprints(m, 0, 8, owners, charts);
+    const std::vector<int32_t> quarterOwners = fineTexelOwners(m, charts, 0, 8, 4);
+    auto weighed = [&](int k, int x) {  // the points of texel (x, 3)'s footprint its k x k texels weigh
+        const std::vector<float> w = fineTexelWeights(m, charts, 0, 8, k);
+        double sum = 0.0;
+        for (int fy = 3 * k; fy < 4 * k; ++fy)
+            for (int fx = x * k; fx < (x + 1) * k; ++fx) sum += w[size_t(fy) * size_t(8 * k) + size_t(fx)];
+        return sum;
+    };
+    int cut = 0;
+    for (int x = 1; x <= 6; ++x) {
+        const TexelFootprint& f = footprints[size_t(3 * 8 + x)];
+        const double whole = f.part(1, 0, 0);
+        ASSERT_GT(whole, 0.0);
+        EXPECT_DOUBLE_EQ(weighed(4, x), whole) << "texel (" << x << ", 3)";
+        cut += weighed(2, x) < whole;
+        // B keeps a quarter-size texel in each texel, above C's
+        int ownB = 0;
+        for (int fx = 4 * x; fx < 4 * x + 4; ++fx) {
+            const int32_t o = quarterOwners[size_t(15) * 32 + size_t(fx)];
+            ownB += o >= 0 && charts[size_t(o)] == charts[2];
+        }
+        EXPECT_GE(ownB, 1) << "texel (" << x << ", 3)";
+    }
+    EXPECT_GE(cut, 3) << "at 2 x 2 B's half-size texels cut C's texels: the test can fail";
 }
 
 // auto: 4 where a fifth of the half-size texels are cut by a chart's edge or
