@@ -118,7 +118,7 @@ std::vector<int32_t> texelOwners(const BakeMesh& mesh, int page, int res, std::v
 // smallest loss first, where that chart keeps at least half its part of the
 // texel in the other quarters (the texel's value leaves the rest out).
 // `coarse`: the texels' owners at res when not texelOwners' (a bake 4 x 4 to
-// a texel takes the half-size texels' as the texels of its quarter-size ones).
+// a texel gives each half-size texel its texel's owner: bake/supersample.h).
 std::vector<int32_t> halfTexelOwners(const BakeMesh& mesh, const std::vector<uint32_t>& charts, int page, int res,
                                      std::vector<uint8_t>* partial = nullptr,
                                      const std::vector<int32_t>* coarse = nullptr);
