@@ -429,7 +429,6 @@ TEST(SunBake, PassesGrowWithTheDirectionsAndLowerTheError) {
     EXPECT_LT(error[1], 0.8 * error[0]);
 }
 
-
 // Where the sun's pixels are far finer than a texel (a scene's finest texels
 // set them: mixed_lighting's chair beside its floor) each pass takes a pixel
 // centre's crossing inside the footprint, every one alike, from the leaf
