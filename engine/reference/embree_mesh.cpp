@@ -5,12 +5,30 @@
 #include <limits>
 
 namespace bb {
+namespace {
+
+// SkipContext's filter: a hit on a skipped triangle is no hit.
+void skipTriangles(const RTCFilterFunctionNArguments* args) {
+    const auto* c = reinterpret_cast<const SkipContext*>(args->context);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] != -1) continue;
+        const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
+        if (prim == c->skip[0] || prim == c->skip[1]) args->valid[i] = 0;
+    }
+}
+
+}  // namespace
+
+SkipContext::SkipContext(uint32_t first, uint32_t second) : skip{first, second} {
+    rtcInitIntersectContext(&context);
+    if (first != kNoTriangle || second != kNoTriangle) context.filter = skipTriangles;
+}
 
 RTCScene commitBakeMeshScene(RTCDevice device, const BakeMesh& mesh, RTCBuildQuality quality) {
     const size_t n = mesh.triangles.size();
     RTCScene scene = rtcNewScene(device);
     if (!scene) return nullptr;
-    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneFlags(scene, RTCSceneFlags(RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION));
     rtcSetSceneBuildQuality(scene, quality);
     RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
     auto* vb = static_cast<float*>(
@@ -46,9 +64,8 @@ float rayOffset(const BakeMesh& mesh) {
     return std::max(2e-5f * extent, 1e-7f);
 }
 
-bool intersectRay(RTCScene scene, const glm::vec3& origin, const glm::vec3& dir, RTCRayHit& rh) {
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
+bool intersectRay(RTCScene scene, const glm::vec3& origin, const glm::vec3& dir, RTCRayHit& rh, uint32_t skip) {
+    SkipContext context(skip);
     rh.ray.org_x = origin.x;
     rh.ray.org_y = origin.y;
     rh.ray.org_z = origin.z;
@@ -63,8 +80,27 @@ bool intersectRay(RTCScene scene, const glm::vec3& origin, const glm::vec3& dir,
     rh.ray.flags = 0;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(scene, &context, &rh);
+    rtcIntersect1(scene, &context.context, &rh);
     return rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+}
+
+bool occludedRay(RTCScene scene, const glm::vec3& origin, const glm::vec3& dir, float tfar, const SkipContext& skip) {
+    SkipContext context = skip;  // Embree takes a mutable context
+    RTCRay ray;
+    ray.org_x = origin.x;
+    ray.org_y = origin.y;
+    ray.org_z = origin.z;
+    ray.dir_x = dir.x;
+    ray.dir_y = dir.y;
+    ray.dir_z = dir.z;
+    ray.tnear = 0.0f;
+    ray.tfar = tfar;
+    ray.time = 0.0f;
+    ray.mask = 0xFFFFFFFFu;
+    ray.id = 0;
+    ray.flags = 0;
+    rtcOccluded1(scene, &context.context, &ray);
+    return ray.tfar < 0.0f;  // set to -inf on a hit
 }
 
 }  // namespace bb

@@ -166,6 +166,7 @@ glm::vec3 sampleTexture(const Texture& t, glm::vec2 uv) {
 // the geometric normal turned to that side.
 struct SurfacePoint {
     glm::vec3 p{0.0f}, ns{0.0f, 1.0f, 0.0f}, ng{0.0f, 1.0f, 0.0f};
+    uint32_t triangle = kNoTriangle;  // the triangle p lies on (its rays skip it), if known
 };
 
 struct Counters {
@@ -222,7 +223,7 @@ struct ReferenceBaker::Impl {
     std::vector<float> lightPdfArea;      // per triangle: P(pick it) / its area (0: not sampled)
     std::vector<uint32_t> emitters;       // emissive triangles
     std::vector<float> emitterCdf;        // over emitters, by area x mean emission factor
-    float eps = 1e-5f;                    // ray offset off surfaces, scene units
+    float eps = 1e-5f;                    // ray offset off a surface whose triangle is not known (a probe point), scene units
 
     std::vector<Texel> texels;
     std::vector<FootprintPiece> pieces;   // the texels' footprints
@@ -243,8 +244,8 @@ struct ReferenceBaker::Impl {
     glm::vec3 sample(const SurfacePoint& start, uint32_t sampleIndex, uint64_t key, const Scrambles& s,
                      Counters& counters) const;
 
-    bool intersect(const glm::vec3& origin, const glm::vec3& dir, RTCRayHit& rh) const;
-    bool occluded(const glm::vec3& origin, const glm::vec3& dir, float tfar) const;
+    glm::vec3 rayOrigin(const SurfacePoint& x) const;
+    bool occluded(const glm::vec3& origin, const glm::vec3& dir, float tfar, const SkipContext& skip) const;
     glm::vec3 environment(const glm::vec3& dir) const;
     glm::vec3 albedoAt(const Material& m, glm::vec2 uv0) const;
     glm::vec3 emissionAt(const Material& m, glm::vec2 uv0) const;
@@ -471,31 +472,19 @@ SurfacePoint ReferenceBaker::Impl::footprintPoint(const Texel& texel, float u1, 
     const float len = glm::length(ns);
     x.ns = len > 0.0f && std::isfinite(len) ? ns / len : ng;
     x.ng = glm::dot(x.ns, ng) >= 0.0f ? ng : -ng;  // the geometric normal on the side the texel looks at
+    x.triangle = t;
     return x;
 }
 
-bool ReferenceBaker::Impl::intersect(const glm::vec3& origin, const glm::vec3& dir, RTCRayHit& rh) const {
-    return intersectRay(rtcScene, origin, dir, rh);
+// Where x's rays start: on its triangle, which they skip (SkipContext), or,
+// for a probe point off any known triangle, off the surface by eps.
+glm::vec3 ReferenceBaker::Impl::rayOrigin(const SurfacePoint& x) const {
+    return x.triangle != kNoTriangle ? x.p : x.p + x.ng * eps;
 }
 
-bool ReferenceBaker::Impl::occluded(const glm::vec3& origin, const glm::vec3& dir, float tfar) const {
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    RTCRay ray;
-    ray.org_x = origin.x;
-    ray.org_y = origin.y;
-    ray.org_z = origin.z;
-    ray.dir_x = dir.x;
-    ray.dir_y = dir.y;
-    ray.dir_z = dir.z;
-    ray.tnear = 0.0f;
-    ray.tfar = tfar;
-    ray.time = 0.0f;
-    ray.mask = 0xFFFFFFFFu;
-    ray.id = 0;
-    ray.flags = 0;
-    rtcOccluded1(rtcScene, &context, &ray);
-    return ray.tfar < 0.0f;  // set to -inf on a hit
+bool ReferenceBaker::Impl::occluded(const glm::vec3& origin, const glm::vec3& dir, float tfar,
+                                    const SkipContext& skip) const {
+    return occludedRay(rtcScene, origin, dir, tfar, skip);
 }
 
 glm::vec3 ReferenceBaker::Impl::environment(const glm::vec3& dir) const {
@@ -532,13 +521,14 @@ glm::vec3 ReferenceBaker::Impl::emissionAt(const Material& m, glm::vec2 uv0) con
 glm::vec3 ReferenceBaker::Impl::directLight(const SurfacePoint& x, const glm::vec3& beta, float u1, float u2,
                                             Counters& counters) const {
     glm::vec3 sum(0.0f);
-    const glm::vec3 origin = x.p + x.ng * eps;
+    const glm::vec3 origin = rayOrigin(x);
+    const SkipContext self(x.triangle);
     for (const DirectionalLight& light : lights) {
         const glm::vec3 toSun = -light.direction;
         float c = glm::dot(x.ns, toSun);
         if (c <= 0.0f || glm::dot(x.ng, toSun) <= 0.0f) continue;
         ++counters.shadowRays;
-        if (!occluded(origin, toSun, std::numeric_limits<float>::infinity()))
+        if (!occluded(origin, toSun, std::numeric_limits<float>::infinity(), self))
             sum += light.irradiance * (c * INV_PI);
     }
     sum += punctualLight(x, counters);
@@ -556,7 +546,7 @@ glm::vec3 ReferenceBaker::Impl::directLight(const SurfacePoint& x, const glm::ve
         glm::vec3 y = b0 * glm::vec3(v[0].position) + b1 * glm::vec3(v[1].position) + b2 * glm::vec3(v[2].position);
         glm::vec3 d = y - x.p;
         float dist2 = glm::dot(d, d);
-        if (dist2 > eps * eps) {
+        if (dist2 > 0.0f) {
             float dist = std::sqrt(dist2);
             glm::vec3 wi = d / dist;
             float cx = glm::dot(x.ns, wi);
@@ -572,15 +562,16 @@ glm::vec3 ReferenceBaker::Impl::directLight(const SurfacePoint& x, const glm::ve
                 glm::vec3 le = emissionAt(m, uv0);
                 if (maxComponent(le) > 0.0f) {
                     ++counters.shadowRays;
-                    // aimed from the offset origin: a ray along wi, shifted by the
-                    // offset, would cross the emitter's plane short of y when it
-                    // leaves x at a grazing angle close above the emitter (the
+                    // aimed from the ray's origin (a ray along wi from an offset
+                    // origin would cross the emitter's plane short of y when it
+                    // leaves x at a grazing angle close above the emitter: the
                     // shared Cornell box's ceiling, 0.9 mm over its light, read
-                    // 1.4 % dark)
+                    // 1.4 % dark), skipping the emitter's triangle: y lies on it
                     const glm::vec3 toY = y - origin;
                     const float len = glm::length(toY);
-                    const float tfar = len - 2.0f * eps;
-                    if (tfar > 0.0f && !occluded(origin, toY / len, tfar)) sum += le * (pb / pl * w);
+                    const float tfar = x.triangle != kNoTriangle ? len * 0.99999f : len - 2.0f * eps;
+                    if (tfar > 0.0f && !occluded(origin, toY / len, tfar, SkipContext(x.triangle, t)))
+                        sum += le * (pb / pl * w);
                 }
             }
         }
@@ -592,16 +583,18 @@ glm::vec3 ReferenceBaker::Impl::directLight(const SurfacePoint& x, const glm::ve
 // each), as L_lm contributions.
 glm::vec3 ReferenceBaker::Impl::punctualLight(const SurfacePoint& x, Counters& counters) const {
     glm::vec3 sum(0.0f);
-    const glm::vec3 origin = x.p + x.ng * eps;
+    const glm::vec3 origin = rayOrigin(x);
+    const SkipContext self(x.triangle);
+    const float margin = x.triangle != kNoTriangle ? 0.0f : 2.0f * eps;
     for (const PunctualLight& light : punctualLights) {
         const glm::vec3 position(light.position - mesh.origin);  // local space
         const glm::vec3 e = punctualIrradiance(light, position, x.p, x.ns);
         if (maxComponent(e) <= 0.0f) continue;
         const glm::vec3 toLight = position - origin;
         const float dist = glm::length(toLight);
-        if (!(dist > 2.0f * eps) || glm::dot(x.ng, toLight) <= 0.0f) continue;
+        if (!(dist > margin) || glm::dot(x.ng, toLight) <= 0.0f) continue;
         ++counters.shadowRays;
-        if (!occluded(origin, toLight / dist, dist - 2.0f * eps)) sum += e * INV_PI;
+        if (!occluded(origin, toLight / dist, dist - margin, self)) sum += e * INV_PI;
     }
     return sum;
 }
@@ -638,8 +631,7 @@ glm::vec3 ReferenceBaker::Impl::sample(const SurfacePoint& start, uint32_t sampl
         if (glm::dot(w, x.ng) <= 0.0f) break;  // below its own triangle: blocked
         RTCRayHit rh;
         ++counters.rays;
-        const glm::vec3 origin = x.p + x.ng * eps;
-        if (!intersect(origin, w, rh)) {
+        if (!intersectRay(rtcScene, rayOrigin(x), w, rh, x.triangle)) {
             radiance += beta * environment(w);
             break;
         }
@@ -688,6 +680,7 @@ glm::vec3 ReferenceBaker::Impl::sample(const SurfacePoint& start, uint32_t sampl
         x.ns = front ? ns : -ns;
         if (glm::dot(x.ns, x.ng) <= 0.0f) x.ns = x.ng;  // a shading normal bent past the face
         x.p = p;
+        x.triangle = uint32_t(tri);
     }
     return radiance;
 }

@@ -7,7 +7,8 @@
 // E. Veach, "Robust Monte Carlo Methods for Light Transport Simulation", PhD
 // thesis, 1997, ch. 9 (multiple importance sampling, power heuristic); M. Pharr,
 // W. Jakob, G. Humphreys, "Physically Based Rendering", 4th ed. (Russian
-// roulette, Owen-scrambled Sobol' samples, spawning rays off surfaces).
+// roulette, Owen-scrambled Sobol' samples); Cycles (Blender 3.2 on: a ray
+// skips the primitive it leaves instead of starting off it).
 //
 // What it computes, per covered texel (centre inside a triangle in page space):
 // the mean over the texel's footprint, i.e. the part of its square (page
@@ -58,12 +59,16 @@
 // t, i): results are the same bits for any thread count and any pass split.
 //
 // Space: the BakeMesh's local space (world - Scene::origin, layout/bake_mesh.h),
-// so ray offsets scale with the scene's size, not its distance from the world
+// so precision follows the scene's size, not its distance from the world
 // origin; suns and the sky are directions, the same in both spaces. Points on
 // surfaces (footprint samples, hits) are kept 1e-5 of the way inside their
 // triangle: a point on the seam of two walls would start rays behind the other
 // wall (the rho 0.9 furnace read 5.8 % low where chart borders crossed texel
-// centres).
+// centres). Their rays start on them and skip their triangle (and an emitter
+// sample's shadow ray the emitter's; reference/embree_mesh.h SkipContext): no
+// offset, which sees past a blocker within it (a wall 4.5 cm off itself under
+// a 25 cm overhang, in a scene 2 km wide). estimate()'s probe points, on no
+// known triangle, start off their surface by rayOffset.
 //
 // Thread-safe: no. One ReferenceBaker is driven from one thread; it runs its
 // own worker threads inside step().
