@@ -17,6 +17,24 @@ void skipTriangles(const RTCFilterFunctionNArguments* args) {
     }
 }
 
+// The segment [0, tfar] of the ray from `origin` along `dir`.
+RTCRay makeRay(const glm::vec3& origin, const glm::vec3& dir, float tfar) {
+    RTCRay ray;
+    ray.org_x = origin.x;
+    ray.org_y = origin.y;
+    ray.org_z = origin.z;
+    ray.dir_x = dir.x;
+    ray.dir_y = dir.y;
+    ray.dir_z = dir.z;
+    ray.tnear = 0.0f;
+    ray.tfar = tfar;
+    ray.time = 0.0f;
+    ray.mask = 0xFFFFFFFFu;
+    ray.id = 0;
+    ray.flags = 0;
+    return ray;
+}
+
 }  // namespace
 
 SkipContext::SkipContext(uint32_t first, uint32_t second) : skip{first, second} {
@@ -66,18 +84,7 @@ float rayOffset(const BakeMesh& mesh) {
 
 bool intersectRay(RTCScene scene, const glm::vec3& origin, const glm::vec3& dir, RTCRayHit& rh, uint32_t skip) {
     SkipContext context(skip);
-    rh.ray.org_x = origin.x;
-    rh.ray.org_y = origin.y;
-    rh.ray.org_z = origin.z;
-    rh.ray.dir_x = dir.x;
-    rh.ray.dir_y = dir.y;
-    rh.ray.dir_z = dir.z;
-    rh.ray.tnear = 0.0f;
-    rh.ray.tfar = std::numeric_limits<float>::infinity();
-    rh.ray.time = 0.0f;
-    rh.ray.mask = 0xFFFFFFFFu;
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
+    rh.ray = makeRay(origin, dir, std::numeric_limits<float>::infinity());
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(scene, &context.context, &rh);
@@ -86,19 +93,7 @@ bool intersectRay(RTCScene scene, const glm::vec3& origin, const glm::vec3& dir,
 
 bool occludedRay(RTCScene scene, const glm::vec3& origin, const glm::vec3& dir, float tfar, const SkipContext& skip) {
     SkipContext context = skip;  // Embree takes a mutable context
-    RTCRay ray;
-    ray.org_x = origin.x;
-    ray.org_y = origin.y;
-    ray.org_z = origin.z;
-    ray.dir_x = dir.x;
-    ray.dir_y = dir.y;
-    ray.dir_z = dir.z;
-    ray.tnear = 0.0f;
-    ray.tfar = tfar;
-    ray.time = 0.0f;
-    ray.mask = 0xFFFFFFFFu;
-    ray.id = 0;
-    ray.flags = 0;
+    RTCRay ray = makeRay(origin, dir, tfar);
     rtcOccluded1(scene, &context.context, &ray);
     return ray.tfar < 0.0f;  // set to -inf on a hit
 }
