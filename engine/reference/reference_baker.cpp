@@ -566,7 +566,9 @@ glm::vec3 ReferenceBaker::Impl::directLight(const SurfacePoint& x, const glm::ve
                     // origin would cross the emitter's plane short of y when it
                     // leaves x at a grazing angle close above the emitter: the
                     // shared Cornell box's ceiling, 0.9 mm over its light, read
-                    // 1.4 % dark), skipping the emitter's triangle: y lies on it
+                    // 1.4 % dark), skipping the emitter's triangle: y lies on it;
+                    // it ends 1e-5 of the way short of y, which may lie on an edge
+                    // the emitter's neighbour shares
                     const glm::vec3 toY = y - origin;
                     const float len = glm::length(toY);
                     const float tfar = x.triangle != kNoTriangle ? len * 0.99999f : len - 2.0f * eps;
