@@ -367,7 +367,8 @@ def scene_hash(cfg, flags):
     h.update(" ".join(flags).encode())
     # the converged reference's bytes come from its baker and rays, the texels' footprints and the seam stitch
     for src in ("engine/reference/reference_baker.cpp", "engine/reference/reference_baker.h",
-                "engine/reference/embree_mesh.cpp", "engine/reference/embree_mesh.h", "engine/layout/bake_mesh.cpp", "engine/layout/bake_mesh.h", "engine/layout/seams.cpp",
+                "engine/reference/embree_mesh.cpp", "engine/reference/embree_mesh.h",
+                "engine/layout/bake_mesh.cpp", "engine/layout/bake_mesh.h", "engine/layout/seams.cpp",
                 "engine/layout/seams.h", "engine/bake/seam_stitch.cpp", "engine/bake/seam_stitch.h"):
         with open(os.path.join(ROOT, src), "rb") as f:
             h.update(f.read())

@@ -223,7 +223,7 @@ struct ReferenceBaker::Impl {
     std::vector<float> lightPdfArea;      // per triangle: P(pick it) / its area (0: not sampled)
     std::vector<uint32_t> emitters;       // emissive triangles
     std::vector<float> emitterCdf;        // over emitters, by area x mean emission factor
-    float eps = 1e-5f;                    // ray offset off a surface whose triangle is not known (a probe point), scene units
+    float eps = 1e-5f;                    // ray offset off a surface of no known triangle (a probe point), scene units
 
     std::vector<Texel> texels;
     std::vector<FootprintPiece> pieces;   // the texels' footprints
@@ -245,7 +245,6 @@ struct ReferenceBaker::Impl {
                      Counters& counters) const;
 
     glm::vec3 rayOrigin(const SurfacePoint& x) const;
-    bool occluded(const glm::vec3& origin, const glm::vec3& dir, float tfar, const SkipContext& skip) const;
     glm::vec3 environment(const glm::vec3& dir) const;
     glm::vec3 albedoAt(const Material& m, glm::vec2 uv0) const;
     glm::vec3 emissionAt(const Material& m, glm::vec2 uv0) const;
@@ -482,11 +481,6 @@ glm::vec3 ReferenceBaker::Impl::rayOrigin(const SurfacePoint& x) const {
     return x.triangle != kNoTriangle ? x.p : x.p + x.ng * eps;
 }
 
-bool ReferenceBaker::Impl::occluded(const glm::vec3& origin, const glm::vec3& dir, float tfar,
-                                    const SkipContext& skip) const {
-    return occludedRay(rtcScene, origin, dir, tfar, skip);
-}
-
 glm::vec3 ReferenceBaker::Impl::environment(const glm::vec3& dir) const {
     if (!options.environment) return options.sky;
     const io::ImageRgb& env = *options.environment;
@@ -528,7 +522,7 @@ glm::vec3 ReferenceBaker::Impl::directLight(const SurfacePoint& x, const glm::ve
         float c = glm::dot(x.ns, toSun);
         if (c <= 0.0f || glm::dot(x.ng, toSun) <= 0.0f) continue;
         ++counters.shadowRays;
-        if (!occluded(origin, toSun, std::numeric_limits<float>::infinity(), self))
+        if (!occludedRay(rtcScene, origin, toSun, std::numeric_limits<float>::infinity(), self))
             sum += light.irradiance * (c * INV_PI);
     }
     sum += punctualLight(x, counters);
@@ -572,7 +566,7 @@ glm::vec3 ReferenceBaker::Impl::directLight(const SurfacePoint& x, const glm::ve
                     const glm::vec3 toY = y - origin;
                     const float len = glm::length(toY);
                     const float tfar = x.triangle != kNoTriangle ? len * 0.99999f : len - 2.0f * eps;
-                    if (tfar > 0.0f && !occluded(origin, toY / len, tfar, SkipContext(x.triangle, t)))
+                    if (tfar > 0.0f && !occludedRay(rtcScene, origin, toY / len, tfar, SkipContext(x.triangle, t)))
                         sum += le * (pb / pl * w);
                 }
             }
@@ -596,7 +590,7 @@ glm::vec3 ReferenceBaker::Impl::punctualLight(const SurfacePoint& x, Counters& c
         const float dist = glm::length(toLight);
         if (!(dist > margin) || glm::dot(x.ng, toLight) <= 0.0f) continue;
         ++counters.shadowRays;
-        if (!occluded(origin, toLight / dist, dist - margin, self)) sum += e * INV_PI;
+        if (!occludedRay(rtcScene, origin, toLight / dist, dist - margin, self)) sum += e * INV_PI;
     }
     return sum;
 }

@@ -474,7 +474,8 @@ TEST(ReferenceBaker, WallUnderAnOverhangInAWideSceneSeesTheSkyFromItsOwnSurface)
     std::vector<double> got(size_t(r.height)), expected(size_t(r.height));
     test::forEachQuadTexel(scene, *layout, *maps, wall, [&](int page, size_t i, const glm::dvec3&, int a, int b) {
         for (int k = 0; k < 64; ++k) {
-            const glm::dvec3 p = test::quadPoint(scene, wall, (a + (k % 8 + 0.5) / 8.0) / r.width, (b + (k / 8 + 0.5) / 8.0) / r.height);
+            const glm::dvec3 p =
+                test::quadPoint(scene, wall, (a + (k % 8 + 0.5) / 8.0) / r.width, (b + (k / 8 + 0.5) / 8.0) / r.height);
             expected[size_t(b)] += (1.0 - test::polygonFormFactor(p, {1, 0, 0}, overhang) -
                                     test::polygonFormFactor(p, {1, 0, 0}, floor)) / 64.0;
         }
@@ -482,8 +483,8 @@ TEST(ReferenceBaker, WallUnderAnOverhangInAWideSceneSeesTheSkyFromItsOwnSurface)
     });
     for (int b = 0; b < r.height; ++b)
         EXPECT_NEAR(got[size_t(b)] / expected[size_t(b)], 1.0, 0.02)
-            << "row " << b << " (its top " << 100.0 * (r.height - 1 - b) / r.height << " cm under the overhang): " << got[size_t(b)] / r.width
-            << " against " << expected[size_t(b)] / r.width;
+            << "row " << b << " (its top " << 100.0 * (r.height - 1 - b) / r.height
+            << " cm under the overhang): " << got[size_t(b)] / r.width << " against " << expected[size_t(b)] / r.width;
 }
 
 // Texel centres on a shared edge belong to exactly one triangle (top-left rule):

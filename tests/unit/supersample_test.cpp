@@ -151,7 +151,8 @@ TEST(Supersample, AQuarterSizeBakeWeighsTheWholeFootprintWhereAStripTookAHalfSiz
     const std::vector<int32_t> owners = texelOwners(m, 0, 8);
     const std::vector<TexelFootprint> footprints = texelFootprints(m, 0, 8, owners, charts);
     const std::vector<int32_t> quarterOwners = fineTexelOwners(m, charts, 0, 8, 4);
-    const std::vector<float> weights2 = fineTexelWeights(m, charts, 0, 8, 2), weights4 = fineTexelWeights(m, charts, 0, 8, 4);
+    const std::vector<float> weights2 = fineTexelWeights(m, charts, 0, 8, 2);
+    const std::vector<float> weights4 = fineTexelWeights(m, charts, 0, 8, 4);
     auto weighed = [&](int k, int x) {  // the points of texel (x, 3)'s footprint its k x k texels weigh
         const std::vector<float>& w = k == 2 ? weights2 : weights4;
         double sum = 0.0;
