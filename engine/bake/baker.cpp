@@ -264,6 +264,8 @@ void Baker::Impl::clearAccumulators() {
     const GLuint zero[4] = {0, 0, 0, 0};
     glClearTexImage(accum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, zero);
     glClearTexImage(halfAccum.id(), 0, GL_RG_INTEGER, GL_UNSIGNED_INT, zero);
+    const float none[4] = {0, 0, 0, 0};
+    glClearTexImage(moments.id(), 0, GL_RGBA, GL_FLOAT, none);
 }
 
 void Baker::Impl::uploadMaterials(const Scene& scene) {
@@ -739,13 +741,15 @@ Status Baker::Impl::init(const Scene& scene) {
         footprint = gl::Texture::create2DArray("texel footprints on their charts", GL_RGB32UI, res, res, pages);
         texelCharts = gl::Texture::create2DArray("texel owners' charts", GL_R16UI, res, res, pages);
         readModes = gl::Texture::create2DArray("radiance read modes", GL_R8UI, res, res, stateLayers());
+        moments = gl::Texture::create2DArray("front texels' first moments", GL_RGBA32F, res, res, pages);
+        slopes = gl::Texture::create2DArray("front texels' slopes inside them", GL_RGBA16F, res, res, pages);
         accumAsFloat = gl::Texture::createView("accumulators as rg32f (direct light sums)", accum, GL_RG32F);
         radianceBits = gl::Texture::createView("outgoing radiance as r32ui", radiance, GL_R32UI);
         radianceAsFloat = gl::Texture::createView("outgoing radiance as r32f (direct light sums)", radiance, GL_R32F);
     }
     stats.lightmapStateBytes =
         accum.bytes() + radiance.bytes() + direct.bytes() + dilation.bytes() + chartNeighbours.bytes() + readModes.bytes() +
-        footprint.bytes() + texelCharts.bytes();
+        footprint.bytes() + texelCharts.bytes() + moments.bytes() + slopes.bytes();
     {
         // the noise estimate's half: about 256^2 sampled texels a page, every texel of small pages
         MemoryCategory category("noise estimate");
@@ -759,6 +763,7 @@ Status Baker::Impl::init(const Scene& scene) {
     clearAccumulators();
     glClearTexImage(radianceBits.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, zero);
     glClearTexImage(direct.id(), 0, GL_RGBA, GL_FLOAT, zero);
+    glClearTexImage(slopes.id(), 0, GL_RGBA, GL_FLOAT, zero);
     pageFbo = gl::Framebuffer::create("light map page framebuffer (no attachments)");
     glNamedFramebufferParameteri(pageFbo.id(), GL_FRAMEBUFFER_DEFAULT_WIDTH, res);
     glNamedFramebufferParameteri(pageFbo.id(), GL_FRAMEBUFFER_DEFAULT_HEIGHT, res);
@@ -829,7 +834,7 @@ Status Baker::Impl::init(const Scene& scene) {
         // the bundle pass: its buffers start small and grow to what the tiles predict
         MemoryCategory category("bundles");
         const BundleScene scene{&mesh, &clusters, vao.id(), vertexBuffer.id(), triangleBuffer.id(),
-                                radiance.id(), readModes.id(), texelCharts.id(), pageFbo.id(), res,
+                                radiance.id(), readModes.id(), texelCharts.id(), slopes.id(), pageFbo.id(), res,
                                 materialAlphaBuffer.id(), alphaTexelBuffer.id(), backLayerOffset};
         const BundleLimits limits{nodeCapacity, maxTileSize, subpixelBits, options.predictTiles};
         auto t = BundleTracer::create(scene, limits, roundingDefine() + backSidesDefine(), &stats);

@@ -62,7 +62,7 @@ struct Baker::Impl {
     // GL objects
     gl::Buffer vertexBuffer, triangleBuffer, metaIndexBuffer;
     gl::VertexArray vao;
-    // Light-map state, per page texel (37 bytes, 50 with back sides; BakeStats::memory):
+    // Light-map state, per page texel (61 bytes, 74 with back sides; BakeStats::memory):
     //   accum      RG32UI  the running mean of incoming radiance and its weight (lib/rounding.glsl's accumulator)
     //   radiance   RGB9_E5 outgoing radiance Lo the bundle pass samples (meta.frag writes it)
     //   direct     RGBA16F direct light L_lm (sun + explicit emitters)
@@ -72,6 +72,10 @@ struct Baker::Impl {
     //   footprint  RGB32UI which part of its square lies on its chart: eighth-texel cells, one more border
     //                      edge and the part's area (texelFootprints)
     //   texelCharts R16UI  its owner's chart, low 16 bits (TRIANGLE_CHART_SHIFT; read by the bundle pass)
+    //   moments    RGBA32F the front texel's first moments: the running means of L_in's sum times its
+    //                      sample's point and of the point (update.frag)
+    //   slopes     RGBA16F the slope of its reflected light inside it and the point it is taken about
+    //                      (meta.frag), which the bundle pass reads where no neighbour on its chart gives one
     // While the direct light is baked, its float sums live in views of accum
     // and radiance (lib/direct_scratch.glsl). Albedo and emission are not
     // stored: the outgoing pass reads them from the materials.
@@ -80,6 +84,7 @@ struct Baker::Impl {
     // with any has accum, radiance and readModes twice over: page p's back sides at layer
     // p + backLayerOffset (13 more bytes a texel; the direct light stays front-only).
     gl::Texture accum, radiance, direct, dilation, chartNeighbours, readModes, footprint, texelCharts;
+    gl::Texture moments, slopes;
     int backLayerOffset = 0;  // 0: no double-sided triangles, one layer per page
     // page p's texel owners: texelOwners, or a supersampled bake's halfTexelOwners
     std::vector<int32_t> bakeTexelOwners(int page, std::vector<uint8_t>* partial) const;

@@ -347,6 +347,8 @@ void BundleTracer::drawBundle(const Tile& tile, const TileFrame& f, bool resetCo
     glBindTextureUnit(BINDING_RADIANCE, scene_.radiance);
     glBindTextureUnit(BINDING_READ_MODES, scene_.readModes);
     glBindTextureUnit(BINDING_TEXEL_CHARTS, scene_.texelCharts);
+    glBindTextureUnit(BINDING_SLOPES, scene_.slopes);
+    glUniform1i(append_.uniform("slopesInside"), scene_.slopes != 0);
     drawClusters(append_.id(), tile.clusters, false);
     glDisable(GL_SCISSOR_TEST);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_ATOMIC_COUNTER_BARRIER_BIT |

@@ -65,6 +65,7 @@ struct BundleScene {
     GLuint radiance = 0;      // outgoing radiance per texel (the bundle pass reads it)
     GLuint readModes = 0;     // per texel, how the bundle pass reads its radiance (lightmap/read_modes.comp)
     GLuint texelCharts = 0;   // per page texel, its owner's chart (low 16 bits): a fragment reads its own chart's texels
+    GLuint slopes = 0;        // per front texel, the slope of its light inside it (lightmap/meta.frag); 0: none read
     GLuint pageFramebuffer = 0;
     int pageResolution = 0;
     // cut-outs (glsl/shared/material_layout.h): per material alpha and the masks' texels
@@ -103,11 +104,13 @@ public:
     // records for a draw of them with the program given (drawCurvedTexelRuns).
     void setCurvedTexels(std::vector<uint32_t> clusterFirst, std::function<void(GLuint)> bind);
     // The outgoing radiance the bundle pass reads, its read modes and texel
-    // charts (BundleScene's): the resolution probe's coarse maps, then back.
-    void setRadianceSource(GLuint radiance, GLuint readModes, GLuint texelCharts) {
+    // charts and the slopes inside its texels (BundleScene's; 0: none): the
+    // resolution probe's coarse maps, then back.
+    void setRadianceSource(GLuint radiance, GLuint readModes, GLuint texelCharts, GLuint slopes) {
         scene_.radiance = radiance;
         scene_.readModes = readModes;
         scene_.texelCharts = texelCharts;
+        scene_.slopes = slopes;
     }
 
     // Both passes read the triangle and vertex buffers as SSBOs in chunks of

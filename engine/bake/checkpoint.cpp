@@ -17,7 +17,7 @@
 namespace bb {
 
 namespace {
-constexpr char CHECKPOINT_MAGIC[8] = {'B', 'B', 'C', 'K', 'P', 'T', '0', '6'};
+constexpr char CHECKPOINT_MAGIC[8] = {'B', 'B', 'C', 'K', 'P', 'T', '0', '7'};
 
 uint64_t fnv1a(const void* data, size_t bytes, uint64_t h = 1469598103934665603ull) {
     const auto* p = static_cast<const uint8_t*>(data);
@@ -162,10 +162,17 @@ Status Baker::saveCheckpoint(const std::string& path) {
     // and the noise estimate's half
     std::vector<glm::uvec2> half(size_t(m.halfWidth) * m.halfWidth * pages);
     gl::readTexture(m.halfAccum.id(), 0, 0, 0, m.halfWidth, m.halfWidth, pages, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, half.data());
+    // and the front texels' moments and the slopes refreshed with the radiance
+    std::vector<glm::vec4> moments(size_t(res) * res * pages);
+    gl::readTexture(m.moments.id(), 0, 0, 0, res, res, pages, GL_RGBA, GL_FLOAT, 16, moments.data());
+    std::vector<uint64_t> slopes(moments.size());  // four fp16s a texel
+    gl::readTexture(m.slopes.id(), 0, 0, 0, res, res, pages, GL_RGBA, GL_HALF_FLOAT, 8, slopes.data());
     std::string bytes(reinterpret_cast<const char*>(&h), sizeof h);
     bytes.append(reinterpret_cast<const char*>(raw.data()), raw.size() * sizeof(glm::uvec2));
     bytes.append(reinterpret_cast<const char*>(radiance.data()), radiance.size() * sizeof(uint32_t));
     bytes.append(reinterpret_cast<const char*>(half.data()), half.size() * sizeof(glm::uvec2));
+    bytes.append(reinterpret_cast<const char*>(moments.data()), moments.size() * sizeof(glm::vec4));
+    bytes.append(reinterpret_cast<const char*>(slopes.data()), slopes.size() * sizeof(uint64_t));
     // then the statistics so far (JSON, length first: doubles round-trip exactly;
     // a shared bake's: an array, one per baker)
     const uint64_t countersBytes = counters.size();
@@ -184,7 +191,9 @@ Status Baker::loadCheckpoint(const std::string& path) {
     const int res = m.layout.resolution;
     const size_t texels = size_t(res) * res * m.stateLayers();
     const size_t halfTexels = size_t(m.halfWidth) * m.halfWidth * m.layout.pageCount;
-    const size_t mapBytes = sizeof h + texels * (sizeof(glm::uvec2) + sizeof(uint32_t)) + halfTexels * sizeof(glm::uvec2);
+    const size_t frontTexels = size_t(res) * res * m.layout.pageCount;
+    const size_t mapBytes = sizeof h + texels * (sizeof(glm::uvec2) + sizeof(uint32_t)) + halfTexels * sizeof(glm::uvec2) +
+                            frontTexels * (sizeof(glm::vec4) + sizeof(uint64_t));
     // every way a file can fail to be this layout's checkpoint, said before anything is read into GL
     const bool headerRead = std::fread(&h, sizeof h, 1, f) == 1;
     size_t fileBytes = 0;
@@ -212,10 +221,14 @@ Status Baker::loadCheckpoint(const std::string& path) {
     std::vector<glm::uvec2> raw(texels);
     std::vector<uint32_t> radiance(texels);
     std::vector<glm::uvec2> half(halfTexels);
+    std::vector<glm::vec4> moments(frontTexels);
+    std::vector<uint64_t> slopes(frontTexels);
     const bool ok = std::fseek(f, long(sizeof h), SEEK_SET) == 0 &&
                     std::fread(raw.data(), sizeof(glm::uvec2), raw.size(), f) == raw.size() &&
                     std::fread(radiance.data(), sizeof(uint32_t), radiance.size(), f) == radiance.size() &&
-                    std::fread(half.data(), sizeof(glm::uvec2), half.size(), f) == half.size();
+                    std::fread(half.data(), sizeof(glm::uvec2), half.size(), f) == half.size() &&
+                    std::fread(moments.data(), sizeof(glm::vec4), moments.size(), f) == moments.size() &&
+                    std::fread(slopes.data(), sizeof(uint64_t), slopes.size(), f) == slopes.size();
     std::string counters(countersBytes, '\0');
     const bool countersRead = ok && std::fseek(f, long(mapBytes + sizeof countersBytes), SEEK_SET) == 0 &&
                               std::fread(counters.data(), 1, counters.size(), f) == counters.size();
@@ -237,6 +250,9 @@ Status Baker::loadCheckpoint(const std::string& path) {
     gl::writeTexture(m.radianceBits.id(), 0, 0, 0, res, res, m.stateLayers(), GL_RED_INTEGER, GL_UNSIGNED_INT, 4,
                      radiance.data());
     m.updateReadModes();  // derived from the radiance map, not saved
+    const int pages = m.layout.pageCount;
+    gl::writeTexture(m.moments.id(), 0, 0, 0, res, res, pages, GL_RGBA, GL_FLOAT, 16, moments.data());
+    gl::writeTexture(m.slopes.id(), 0, 0, 0, res, res, pages, GL_RGBA, GL_HALF_FLOAT, 8, slopes.data());
     gl::writeTexture(m.halfAccum.id(), 0, 0, 0, m.halfWidth, m.halfWidth, m.layout.pageCount, GL_RG_INTEGER,
                      GL_UNSIGNED_INT, 8, half.data());
     m.stats = restored;

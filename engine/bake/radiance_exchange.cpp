@@ -36,6 +36,7 @@ void Baker::Impl::beginDirection(int k) {
         for (const gl::Program* program : {&triangles, &curved}) setUpdateUniforms(*program, sampleWeight, k);
         glBindImageTexture(BINDING_HALF_ACCUM, halfAccum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
         glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RG32UI);
+        glBindImageTexture(BINDING_MOMENTS, moments.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
         return BundleTracer::UpdatePrograms{triangles.id(), curvedTexelCount() ? curved.id() : 0u};
     };
     tracer->begin(directionFrame(k), tilerOptions, seed, true, options.leafRuns);
@@ -134,20 +135,29 @@ void Baker::Impl::combineShares(int round) {
     // one's accumLogScale follows its own rescales): weights W and W x mean.
     const double logScale = rampLogWeight(round);
     const float toCommon = float(std::exp(accumLogScale - logScale));
-    // the whole's accumulators, then the noise estimate's half
-    // (a double-sided scene's back sides' layers follow their page's covered texels)
+    // the whole's accumulators (and its front texels' moments, at the same
+    // weights), then the noise estimate's half (a double-sided scene's back
+    // sides' layers follow their page's covered texels)
     const auto combine = [&](const gl::Texture& texture, int width, int layers,
-                             const std::vector<std::vector<uint32_t>>& coveredIndex, uint32_t salt) {
+                             const std::vector<std::vector<uint32_t>>& coveredIndex, uint32_t salt,
+                             const gl::Texture* withMoments) {
         const size_t pageTexels = size_t(width) * width;
         const auto rnd = [&](size_t texel, uint32_t channel) {
             return uniform01(pcgHash(uint32_t(options.seed) ^ pcgHash(uint32_t(texel) * 4u + channel) ^
                                      pcgHash(uint32_t(round) + salt)));
         };
         std::vector<glm::uvec2> raw(pageTexels);
-        std::vector<float> sums;
+        std::vector<glm::vec4> moments;
+        std::vector<float> sums, momentSums;
         for (int p = 0; p < layers; ++p) {
             const std::vector<uint32_t>& covered = coveredIndex[size_t(p % layout.pageCount)];
             gl::readTexture(texture.id(), 0, 0, p, width, width, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
+            const bool front = withMoments && p < layout.pageCount;
+            if (front) {
+                moments.resize(pageTexels);
+                gl::readTexture(withMoments->id(), 0, 0, p, width, width, 1, GL_RGBA, GL_FLOAT, 16, moments.data());
+                momentSums.assign(covered.size() * 4, 0.0f);
+            }
             sums.assign(covered.size() * 4, 0.0f);
             for (size_t i = 0; i < covered.size(); ++i) {
                 const glm::vec4 state = decodeAccumulator(raw[covered[i]]);
@@ -156,9 +166,20 @@ void Baker::Impl::combineShares(int round) {
                 sums[4 * i + 1] = state.g * w;
                 sums[4 * i + 2] = state.b * w;
                 sums[4 * i + 3] = w;
+                if (front)
+                    for (int c = 0; c < 4; ++c) momentSums[4 * i + size_t(c)] = moments[covered[i]][c] * w;
             }
             share.sum(sums.data(), sums.size());
             stats.combineBytes += int64_t(sums.size() * sizeof(float));
+            if (front) {
+                share.sum(momentSums.data(), momentSums.size());
+                stats.combineBytes += int64_t(momentSums.size() * sizeof(float));
+                for (size_t i = 0; i < covered.size(); ++i) {
+                    const float w = sums[4 * i + 3];
+                    for (int c = 0; c < 4; ++c) moments[covered[i]][c] = w > 0.0f ? momentSums[4 * i + size_t(c)] / w : 0.0f;
+                }
+                gl::writeTexture(withMoments->id(), 0, 0, p, width, width, 1, GL_RGBA, GL_FLOAT, 16, moments.data());
+            }
             // every baker stores the combined means (the outgoing pass reads them);
             // the rounding's random numbers are the same on all, so are the bits
             for (size_t i = 0; i < covered.size(); ++i) {
@@ -173,8 +194,8 @@ void Baker::Impl::combineShares(int round) {
             gl::writeTexture(texture.id(), 0, 0, p, width, width, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
         }
     };
-    combine(accum, res, stateLayers(), coveredTexelIndex, 0x68e31da4u);
-    combine(halfAccum, halfWidth, layout.pageCount, halfCoveredTexelIndex, 0x2545f491u);
+    combine(accum, res, stateLayers(), coveredTexelIndex, 0x68e31da4u, &moments);
+    combine(halfAccum, halfWidth, layout.pageCount, halfCoveredTexelIndex, 0x2545f491u, nullptr);
     accumLogScale = logScale;
     ++stats.combines;
 }
@@ -187,6 +208,10 @@ void Baker::Impl::refreshRadiance(uint32_t key) {
     glBindImageTexture(BINDING_ACCUM, accum.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RG32UI);
     glBindImageTexture(BINDING_DIRECT, direct.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
     glBindImageTexture(BINDING_RADIANCE_BITS, radianceBits.id(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32UI);
+    glBindImageTexture(BINDING_MOMENTS, moments.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
+    glBindImageTexture(BINDING_SLOPES_IMAGE, slopes.id(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA16F);
+    glBindTextureUnit(BINDING_FOOTPRINT, footprint.id());
+    glBindTextureUnit(BINDING_TEXEL_CHARTS, texelCharts.id());
     glUniform1i(metaProgram.uniform("layerOffset"), 0);
     drawSurface(metaProgram.id(), true);
     if (backLayerOffset != 0) {  // the back sides' layers

@@ -206,9 +206,9 @@ void Baker::Impl::probeResolution() {
         for (int level = 0; level < kLevels; ++level) {
             const CoarseLevel* coarse = level == 1 ? &output : level == 2 ? &twice : nullptr;
             if (coarse)
-                tracer->setRadianceSource(coarse->radiance.id(), coarse->modes.id(), coarse->charts.id());
+                tracer->setRadianceSource(coarse->radiance.id(), coarse->modes.id(), coarse->charts.id(), 0);
             else
-                tracer->setRadianceSource(radiance.id(), readModes.id(), texelCharts.id());
+                tracer->setRadianceSource(radiance.id(), readModes.id(), texelCharts.id(), slopes.id());
             const int slot = 2 * level + d % 2;
             tracer->run(directionFrame(d), tilerOptions, directionSeed(d), false,
                         [&](const TileFrame& f, uint32_t) {
@@ -223,7 +223,7 @@ void Baker::Impl::probeResolution() {
                         },
                         options.leafRuns);
         }
-    tracer->setRadianceSource(radiance.id(), readModes.id(), texelCharts.id());
+    tracer->setRadianceSource(radiance.id(), readModes.id(), texelCharts.id(), slopes.id());
     glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
 
     // Each sampled texel's six values (its half-size texels' means at the

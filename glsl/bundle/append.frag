@@ -29,6 +29,8 @@ layout(std430, binding = BINDING_NODES) buffer Nodes { Node nodes[]; };
 layout(binding = BINDING_RADIANCE) uniform sampler2DArray radiance;
 layout(binding = BINDING_READ_MODES) uniform usampler2DArray readModes;
 layout(binding = BINDING_TEXEL_CHARTS) uniform usampler2DArray texelCharts;
+layout(binding = BINDING_SLOPES) uniform sampler2DArray slopes;
+uniform bool slopesInside;  // the slopes are the radiance map's (not while the resolution probe reads coarser maps)
 
 uniform uint nodeCapacity;
 uniform uint randomSeed;  // per direction and leaf (not per tile: tiles change with the budget, the bytes must not)
@@ -105,7 +107,19 @@ vec3 radianceAt(vec2 uv, int page, int layer, uint chart) {
     vec3 lo = m, hi = m;
     if (modeX != READ_NONE) lo = min(lo, min(l, r)), hi = max(hi, max(l, r));
     if (modeY != READ_NONE) lo = min(lo, min(d, u)), hi = max(hi, max(d, u));
-    return clamp(m + axisOffset(modeX, l, m, r, f.x) + axisOffset(modeY, d, m, u, f.y), lo, hi);
+    vec3 read = clamp(m + axisOffset(modeX, l, m, r, f.x) + axisOffset(modeY, d, m, u, f.y), lo, hi);
+    // Along an axis with no neighbour on the chart to take a slope from (a
+    // chart's edge, a strip a texel wide), the slope measured inside the texel
+    // (meta.frag slopeInside), about its footprint's centroid, on its
+    // reflected light's colour, within the mean either way
+    float total = dot(m, vec3(1.0));
+    if (slopesInside && layer == page && (modeX == READ_NONE || modeY == READ_NONE) && total > 0.0) {
+        vec4 inside = texelFetch(slopes, ivec3(c, page), 0);
+        vec2 along = vec2(modeX == READ_NONE ? 1.0 : 0.0, modeY == READ_NONE ? 1.0 : 0.0);
+        float offset = dot(inside.xy * along, f - inside.zw);
+        read += m * clamp(offset / total, -1.0, 1.0);
+    }
+    return max(read, vec3(0.0));
 }
 
 void main() {

@@ -59,6 +59,31 @@ bool insideFootprintEdge(uint code, vec2 offset) {
 // The part of the texel's square the footprint test takes as on its chart (0..1).
 float footprintArea(uvec3 footprint) { return max(float(footprint.z >> 24u), 1.0) / 255.0; }
 
+// The covariance (xx, xy, yy) of a point uniform over the eighth-texel cells
+// that touch the chart (`cells`, cellOnChart's; the whole square if none), in
+// texels: how a texel's samples spread, for the slope of its light inside it
+// (lightmap/meta.frag). Sums over the cells' columns and rows by bit counts.
+vec3 footprintSpread(uvec2 cells) {
+    if (cells == uvec2(0u) || cells == uvec2(0xffffffffu)) return vec3(1.0 / 12.0, 0.0, 1.0 / 12.0);
+    float n = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0, syy = 0.0;
+    for (uint row = 0u; row < 8u; ++row) {
+        uint bits = ((row < 4u ? cells.x : cells.y) >> (8u * (row & 3u))) & 0xffu;
+        // the row's count, the sum of its cells' indices and of their squares
+        float count = float(bitCount(bits));
+        float index = float(bitCount(bits & 0xaau) + 2 * bitCount(bits & 0xccu) + 4 * bitCount(bits & 0xf0u));
+        float square = 0.0;
+        for (uint i = 1u; i < 8u; ++i) square += float(i * i) * float((bits >> i) & 1u);
+        float y = float(row);
+        n += count, sy += count * y, syy += count * y * y;
+        sx += index, sxx += square, sxy += index * y;
+    }
+    // cell index i is at (i + 1/2) / 8 - 1/2 texels: the covariance of the
+    // indices / 64, and each cell's own spread (uniform over an eighth: 1 / 768)
+    vec2 mean = vec2(sx, sy) / n;
+    return vec3(sxx / n - mean.x * mean.x, sxy / n - mean.x * mean.y, syy / n - mean.y * mean.y) / 64.0 +
+           vec3(1.0 / 768.0, 0.0, 1.0 / 768.0);
+}
+
 #ifdef CURVED_FOOTPRINT
 // A flat curved texel whose flat test is inexact (CURVED_TEXEL_EXACT): its
 // index, set by its pass before it samples; its triangles then decide

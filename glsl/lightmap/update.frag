@@ -67,6 +67,11 @@ uniform uint randomSeed;
 // kept at every halfStride-th texel of each axis.
 layout(binding = BINDING_HALF_ACCUM, rg32ui) uniform coherent uimage2DArray halfAccum;
 uniform bool oddDirection;
+// Each front texel's first moments: the running means of L_in's channel sum
+// times the sample's point (texels from its centre) and of the point itself,
+// folded at the accumulator's weights; lightmap/meta.frag makes them the slope
+// of the texel's light inside it, which the bundle pass reads at chart edges.
+layout(binding = BINDING_MOMENTS, rgba32f) uniform coherent image2DArray moments;
 #ifdef RESOLUTION_PROBE
 // The resolution probe (engine/bake/resolution_probe.cpp): this pass's
 // samples, weighted, into its layers of the probe's sums at the noise
@@ -370,6 +375,8 @@ struct TexelSample {
     float curvature;
     uint flags;
     float weight;
+    vec2 point;  // the point, texels from the texel's centre along the page's axes
+    bool flat_;  // point holds it (a curved texel's samples keep no moments)
 };
 
 // One sample of a texel along its triangle's plane (frame f at the texel's
@@ -410,6 +417,8 @@ bool planeSample(FlatFrame f, ivec3 texel, vec3 leafPoint, out TexelSample s) {
     }
 #endif
     s.position = f.position + f.positionDx * jitter.x + f.positionDy * jitter.y;
+    s.point = jitter;
+    s.flat_ = true;
     s.anchor = leafPoint;
     // the shading normal where the point leaves the triangle, not extrapolated
     // past it: a triangle far smaller than a texel (300 to a texel on the
@@ -468,6 +477,8 @@ bool curvedSample(out TexelSample s) {
     s.curvature = tri.corner2.w;
     s.flags = floatBitsToUint(tri.corner2.z);
     s.weight = 1.0;
+    s.point = vec2(0.0);
+    s.flat_ = false;
     return true;
 }
 #else
@@ -611,7 +622,13 @@ void main() {
     return;
 #endif
     uint h = pcgHash(randomSeed ^ pcgHash(uint(texel.x) | (uint(texel.y) << 16u)) ^ pcgHash(uint(texel.z) + 7919u));
-    imageStore(accum, texel, uvec4(foldSample(imageLoad(accum, texel).rg, incoming, w, h), 0u, 0u));
+    uvec2 stored = imageLoad(accum, texel).rg;
+    if (s.flat_) {
+        float share = w / (decodeAccumulator(stored).a + w);
+        vec4 moment = imageLoad(moments, texel);
+        imageStore(moments, texel, moment + (vec4(dot(incoming, vec3(1.0)) * s.point, s.point) - moment) * share);
+    }
+    imageStore(accum, texel, uvec4(foldSample(stored, incoming, w, h), 0u, 0u));
 #ifdef BACK_SIDES
     // A double-sided triangle's back side: the nearest node the other way,
     // which it sees along the same line at the same cosine, into its own

@@ -61,6 +61,8 @@ struct LeafRecord {
 #define BINDING_DIRECT_ODD_SUMS 6  // image unit, direct light passes only: rgba32f an emitter triangle's or a sun's
                                    // odd samples' sums at the noise estimate's sampled texels (halfAccum's size)
 #define BINDING_DIRECT_VARIANCE 7  // image unit, direct light passes only: r32f its light's variance per sampled texel
+#define BINDING_MOMENTS 4        // image unit, update and outgoing passes: rg32f each front texel's first moments (update.frag)
+#define BINDING_SLOPES_IMAGE 6   // image unit, outgoing pass only: rgba16f the slopes inside each front texel (meta.frag)
 #define BINDING_PROBE_SUMS 7      // image unit, resolution probe's update pass only: rgba32f sums (bake/resolution_probe.cpp)
 #define BINDING_DIRECT_WEIGHTS 1   // image unit, direct noise pass only: the noise weights (BINDING_NOISE_WEIGHTS')
 #define BINDING_RADIANCE 0       // texture unit: RGB9_E5 outgoing radiance Lo per texel, array of pages
@@ -68,6 +70,7 @@ struct LeafRecord {
 #define BINDING_MATERIAL_TEX 2   // texture unit: a material's albedo texture (emission: + 1)
 #define BINDING_READ_MODES 4     // texture unit: r8ui per texel: READ_* per axis (lightmap/read_modes.comp)
 #define BINDING_FOOTPRINT 5       // texture unit: rgb32ui per texel: its square's part on its chart (texelFootprints)
+#define BINDING_SLOPES 7         // texture unit: rgba16f per front texel: the slope of its light inside it (meta.frag)
 #define BINDING_TEXEL_CHARTS 6   // texture unit: r16ui per texel: its owner's chart, low 15 bits, and TEXEL_CURVED (mesh_layout.h)
 #define BINDING_CHART_NEIGHBOURS_IMAGE 6  // image unit, read-modes pass only (the dilation's unit elsewhere)
 #define BINDING_READ_MODES_IMAGE 7        // image unit, read-modes pass only (the resolve target's unit elsewhere)
