@@ -741,8 +741,8 @@ Status Baker::Impl::init(const Scene& scene) {
         footprint = gl::Texture::create2DArray("texel footprints on their charts", GL_RGB32UI, res, res, pages);
         texelCharts = gl::Texture::create2DArray("texel owners' charts", GL_R16UI, res, res, pages);
         readModes = gl::Texture::create2DArray("radiance read modes", GL_R8UI, res, res, stateLayers());
-        moments = gl::Texture::create2DArray("front texels' first moments", GL_RGBA32F, res, res, pages);
-        slopes = gl::Texture::create2DArray("front texels' slopes inside them", GL_RGBA16F, res, res, pages);
+        moments = gl::Texture::create2DArray("texels' first moments", GL_RGBA32F, res, res, stateLayers());
+        slopes = gl::Texture::create2DArray("texels' slopes inside them", GL_RGBA16F, res, res, stateLayers());
         accumAsFloat = gl::Texture::createView("accumulators as rg32f (direct light sums)", accum, GL_RG32F);
         radianceBits = gl::Texture::createView("outgoing radiance as r32ui", radiance, GL_R32UI);
         radianceAsFloat = gl::Texture::createView("outgoing radiance as r32f (direct light sums)", radiance, GL_R32F);

@@ -62,7 +62,7 @@ struct Baker::Impl {
     // GL objects
     gl::Buffer vertexBuffer, triangleBuffer, metaIndexBuffer;
     gl::VertexArray vao;
-    // Light-map state, per page texel (61 bytes, 74 with back sides; BakeStats::memory):
+    // Light-map state, per page texel (61 bytes, 98 with back sides; BakeStats::memory):
     //   accum      RG32UI  the running mean of incoming radiance and its weight (lib/rounding.glsl's accumulator)
     //   radiance   RGB9_E5 outgoing radiance Lo the bundle pass samples (meta.frag writes it)
     //   direct     RGBA16F direct light L_lm (sun + explicit emitters)
@@ -72,7 +72,7 @@ struct Baker::Impl {
     //   footprint  RGB32UI which part of its square lies on its chart: eighth-texel cells, one more border
     //                      edge and the part's area (texelFootprints)
     //   texelCharts R16UI  its owner's chart, low 16 bits (TRIANGLE_CHART_SHIFT; read by the bundle pass)
-    //   moments    RGBA32F the front texel's first moments: the running means of L_in's sum times its
+    //   moments    RGBA32F the texel's first moments: the running means of L_in's sum times its
     //                      sample's point and of the point (update.frag)
     //   slopes     RGBA16F the slope of its reflected light inside it and the point it is taken about
     //                      (meta.frag), which the bundle pass reads where no neighbour on its chart gives one
@@ -81,8 +81,8 @@ struct Baker::Impl {
     // stored: the outgoing pass reads them from the materials.
     // Double-sided triangles light both sides differently (a panel light under a
     // ceiling: its back reflects the ceiling's light onto it again), so a scene
-    // with any has accum, radiance and readModes twice over: page p's back sides at layer
-    // p + backLayerOffset (13 more bytes a texel; the direct light stays front-only).
+    // with any has accum, radiance, readModes, moments and slopes twice over: page p's back
+    // sides at layer p + backLayerOffset (37 more bytes a texel; the direct light stays front-only).
     gl::Texture accum, radiance, direct, dilation, chartNeighbours, readModes, footprint, texelCharts;
     gl::Texture moments, slopes;
     int backLayerOffset = 0;  // 0: no double-sided triangles, one layer per page

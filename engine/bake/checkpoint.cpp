@@ -162,11 +162,11 @@ Status Baker::saveCheckpoint(const std::string& path) {
     // and the noise estimate's half
     std::vector<glm::uvec2> half(size_t(m.halfWidth) * m.halfWidth * pages);
     gl::readTexture(m.halfAccum.id(), 0, 0, 0, m.halfWidth, m.halfWidth, pages, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, half.data());
-    // and the front texels' moments and the slopes refreshed with the radiance
-    std::vector<glm::vec4> moments(size_t(res) * res * pages);
-    gl::readTexture(m.moments.id(), 0, 0, 0, res, res, pages, GL_RGBA, GL_FLOAT, 16, moments.data());
+    // and the texels' moments and the slopes refreshed with the radiance
+    std::vector<glm::vec4> moments(raw.size());
+    gl::readTexture(m.moments.id(), 0, 0, 0, res, res, layers, GL_RGBA, GL_FLOAT, 16, moments.data());
     std::vector<uint64_t> slopes(moments.size());  // four fp16s a texel
-    gl::readTexture(m.slopes.id(), 0, 0, 0, res, res, pages, GL_RGBA, GL_HALF_FLOAT, 8, slopes.data());
+    gl::readTexture(m.slopes.id(), 0, 0, 0, res, res, layers, GL_RGBA, GL_HALF_FLOAT, 8, slopes.data());
     std::string bytes(reinterpret_cast<const char*>(&h), sizeof h);
     bytes.append(reinterpret_cast<const char*>(raw.data()), raw.size() * sizeof(glm::uvec2));
     bytes.append(reinterpret_cast<const char*>(radiance.data()), radiance.size() * sizeof(uint32_t));
@@ -191,9 +191,8 @@ Status Baker::loadCheckpoint(const std::string& path) {
     const int res = m.layout.resolution;
     const size_t texels = size_t(res) * res * m.stateLayers();
     const size_t halfTexels = size_t(m.halfWidth) * m.halfWidth * m.layout.pageCount;
-    const size_t frontTexels = size_t(res) * res * m.layout.pageCount;
-    const size_t mapBytes = sizeof h + texels * (sizeof(glm::uvec2) + sizeof(uint32_t)) + halfTexels * sizeof(glm::uvec2) +
-                            frontTexels * (sizeof(glm::vec4) + sizeof(uint64_t));
+    const size_t mapBytes = sizeof h + texels * (sizeof(glm::uvec2) + sizeof(uint32_t) + sizeof(glm::vec4) + sizeof(uint64_t)) +
+                            halfTexels * sizeof(glm::uvec2);
     // every way a file can fail to be this layout's checkpoint, said before anything is read into GL
     const bool headerRead = std::fread(&h, sizeof h, 1, f) == 1;
     size_t fileBytes = 0;
@@ -221,8 +220,8 @@ Status Baker::loadCheckpoint(const std::string& path) {
     std::vector<glm::uvec2> raw(texels);
     std::vector<uint32_t> radiance(texels);
     std::vector<glm::uvec2> half(halfTexels);
-    std::vector<glm::vec4> moments(frontTexels);
-    std::vector<uint64_t> slopes(frontTexels);
+    std::vector<glm::vec4> moments(texels);
+    std::vector<uint64_t> slopes(texels);
     const bool ok = std::fseek(f, long(sizeof h), SEEK_SET) == 0 &&
                     std::fread(raw.data(), sizeof(glm::uvec2), raw.size(), f) == raw.size() &&
                     std::fread(radiance.data(), sizeof(uint32_t), radiance.size(), f) == radiance.size() &&
@@ -250,9 +249,8 @@ Status Baker::loadCheckpoint(const std::string& path) {
     gl::writeTexture(m.radianceBits.id(), 0, 0, 0, res, res, m.stateLayers(), GL_RED_INTEGER, GL_UNSIGNED_INT, 4,
                      radiance.data());
     m.updateReadModes();  // derived from the radiance map, not saved
-    const int pages = m.layout.pageCount;
-    gl::writeTexture(m.moments.id(), 0, 0, 0, res, res, pages, GL_RGBA, GL_FLOAT, 16, moments.data());
-    gl::writeTexture(m.slopes.id(), 0, 0, 0, res, res, pages, GL_RGBA, GL_HALF_FLOAT, 8, slopes.data());
+    gl::writeTexture(m.moments.id(), 0, 0, 0, res, res, m.stateLayers(), GL_RGBA, GL_FLOAT, 16, moments.data());
+    gl::writeTexture(m.slopes.id(), 0, 0, 0, res, res, m.stateLayers(), GL_RGBA, GL_HALF_FLOAT, 8, slopes.data());
     gl::writeTexture(m.halfAccum.id(), 0, 0, 0, m.halfWidth, m.halfWidth, m.layout.pageCount, GL_RG_INTEGER,
                      GL_UNSIGNED_INT, 8, half.data());
     m.stats = restored;

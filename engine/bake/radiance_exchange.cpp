@@ -135,7 +135,7 @@ void Baker::Impl::combineShares(int round) {
     // one's accumLogScale follows its own rescales): weights W and W x mean.
     const double logScale = rampLogWeight(round);
     const float toCommon = float(std::exp(accumLogScale - logScale));
-    // the whole's accumulators (and its front texels' moments, at the same
+    // the whole's accumulators (and its texels' moments, at the same
     // weights), then the noise estimate's half (a double-sided scene's back
     // sides' layers follow their page's covered texels)
     const auto combine = [&](const gl::Texture& texture, int width, int layers,
@@ -152,8 +152,7 @@ void Baker::Impl::combineShares(int round) {
         for (int p = 0; p < layers; ++p) {
             const std::vector<uint32_t>& covered = coveredIndex[size_t(p % layout.pageCount)];
             gl::readTexture(texture.id(), 0, 0, p, width, width, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, 8, raw.data());
-            const bool front = withMoments && p < layout.pageCount;
-            if (front) {
+            if (withMoments) {
                 moments.resize(pageTexels);
                 gl::readTexture(withMoments->id(), 0, 0, p, width, width, 1, GL_RGBA, GL_FLOAT, 16, moments.data());
                 momentSums.assign(covered.size() * 4, 0.0f);
@@ -166,12 +165,12 @@ void Baker::Impl::combineShares(int round) {
                 sums[4 * i + 1] = state.g * w;
                 sums[4 * i + 2] = state.b * w;
                 sums[4 * i + 3] = w;
-                if (front)
+                if (withMoments)
                     for (int c = 0; c < 4; ++c) momentSums[4 * i + size_t(c)] = moments[covered[i]][c] * w;
             }
             share.sum(sums.data(), sums.size());
             stats.combineBytes += int64_t(sums.size() * sizeof(float));
-            if (front) {
+            if (withMoments) {
                 share.sum(momentSums.data(), momentSums.size());
                 stats.combineBytes += int64_t(momentSums.size() * sizeof(float));
                 for (size_t i = 0; i < covered.size(); ++i) {
@@ -211,7 +210,7 @@ void Baker::Impl::refreshRadiance(uint32_t key) {
     glBindImageTexture(BINDING_MOMENTS, moments.id(), 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
     glBindImageTexture(BINDING_SLOPES_IMAGE, slopes.id(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA16F);
     glBindTextureUnit(BINDING_FOOTPRINT, footprint.id());
-    glBindTextureUnit(BINDING_TEXEL_CHARTS, texelCharts.id());
+    glBindTextureUnit(BINDING_CHART_NEIGHBOURS, chartNeighbours.id());
     glUniform1i(metaProgram.uniform("layerOffset"), 0);
     drawSurface(metaProgram.id(), true);
     if (backLayerOffset != 0) {  // the back sides' layers

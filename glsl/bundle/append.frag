@@ -113,8 +113,8 @@ vec3 radianceAt(vec2 uv, int page, int layer, uint chart) {
     // (meta.frag slopeInside), about its footprint's centroid, on its
     // reflected light's colour, within the mean either way
     float total = dot(m, vec3(1.0));
-    if (slopesInside && layer == page && (modeX == READ_NONE || modeY == READ_NONE) && total > 0.0) {
-        vec4 inside = texelFetch(slopes, ivec3(c, page), 0);
+    if (slopesInside && (modeX == READ_NONE || modeY == READ_NONE) && total > 0.0) {
+        vec4 inside = texelFetch(slopes, ivec3(c, layer), 0);
         vec2 along = vec2(modeX == READ_NONE ? 1.0 : 0.0, modeY == READ_NONE ? 1.0 : 0.0);
         float offset = dot(inside.xy * along, f - inside.zw);
         read += m * clamp(offset / total, -1.0, 1.0);

@@ -68,11 +68,12 @@ vec3 footprintSpread(uvec2 cells) {
     float n = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0, syy = 0.0;
     for (uint row = 0u; row < 8u; ++row) {
         uint bits = ((row < 4u ? cells.x : cells.y) >> (8u * (row & 3u))) & 0xffu;
-        // the row's count, the sum of its cells' indices and of their squares
+        // the row's count, the sum of its cells' indices i = b0 + 2 b1 + 4 b2
+        // and of their squares b0 + 4 b1 + 16 b2 + 4 b0 b1 + 8 b0 b2 + 16 b1 b2
         float count = float(bitCount(bits));
         float index = float(bitCount(bits & 0xaau) + 2 * bitCount(bits & 0xccu) + 4 * bitCount(bits & 0xf0u));
-        float square = 0.0;
-        for (uint i = 1u; i < 8u; ++i) square += float(i * i) * float((bits >> i) & 1u);
+        float square = float(bitCount(bits & 0xaau) + 4 * bitCount(bits & 0xccu) + 16 * bitCount(bits & 0xf0u) +
+                             4 * bitCount(bits & 0x88u) + 8 * bitCount(bits & 0xa0u) + 16 * bitCount(bits & 0xc0u));
         float y = float(row);
         n += count, sy += count * y, syy += count * y * y;
         sx += index, sxx += square, sxy += index * y;

@@ -40,13 +40,14 @@ uniform bool hasEmissionTexture;
 uniform bool includeEmission;  // false when emitters are lit explicitly: bundles then carry reflected light only
 uniform uint randomSeed;       // per refresh
 uniform int layerOffset;       // 0: the front sides; else the back sides' layers (page + layerOffset)
-// The front texels' slopes inside them (append.frag radianceAt): from their
+// The texels' slopes inside them (append.frag radianceAt): from their
 // first moments (update.frag) and their footprints' spread
 #include "shared/mesh_layout.h"
 #include "lib/texel_footprint.glsl"
 layout(binding = BINDING_MOMENTS, rgba32f) uniform readonly image2DArray moments;
 layout(binding = BINDING_SLOPES_IMAGE, rgba16f) uniform writeonly image2DArray slopes;
 layout(binding = BINDING_FOOTPRINT) uniform usampler2DArray footprint;
+layout(binding = BINDING_CHART_NEIGHBOURS) uniform usampler2DArray chartNeighbours;
 
 // The slope of the texel's reflected light (its channels' sum) along x and y
 // inside it, per texel, and its samples' mean point, about which the slope is
@@ -54,12 +55,15 @@ layout(binding = BINDING_FOOTPRINT) uniform usampler2DArray footprint;
 // L_in and the point, over the footprint's spread), times the albedo. Zero for
 // a curved texel (it keeps no moments: update.frag).
 vec4 slopeInside(ivec3 texel, vec3 a, vec3 m) {
+    // read only along an axis without a neighbour on the chart each way (read_modes.comp)
+    const uint everyNeighbour = CHART_NEIGHBOUR_LEFT | CHART_NEIGHBOUR_RIGHT | CHART_NEIGHBOUR_DOWN | CHART_NEIGHBOUR_UP;
+    if ((texelFetch(chartNeighbours, ivec3(texel.xy, page), 0).r & everyNeighbour) == everyNeighbour) return vec4(0.0);
     vec4 moment = imageLoad(moments, texel);
     float total = dot(m, vec3(1.0));
     if (moment == vec4(0.0) || total <= 0.0) return vec4(0.0);
     vec2 mid = moment.zw;  // the samples' mean point
     vec2 covariance = moment.xy - total * mid;
-    vec3 spread = footprintSpread(texelFetch(footprint, texel, 0).xy);
+    vec3 spread = footprintSpread(texelFetch(footprint, ivec3(texel.xy, page), 0).xy);
     vec2 slope = inverse(mat2(spread.x, spread.y, spread.y, spread.z)) * covariance;
     return vec4(slope * (dot(clamp(a, 0.0, 1.0), m) / total), mid);
 }
@@ -73,10 +77,8 @@ void main() {
     ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), page + layerOffset);
     vec4 state = decodeAccumulator(imageLoad(accum, texel).rg);
     vec3 l = state.a > 0.0 ? state.rgb : vec3(0.0);
-    if (layerOffset == 0) {
-        imageStore(slopes, texel, slopeInside(texel, a, l));
-        l += imageLoad(directMap, texel).rgb;
-    }
+    imageStore(slopes, texel, slopeInside(texel, a, l));
+    if (layerOffset == 0) l += imageLoad(directMap, texel).rgb;
     vec3 lo = (includeEmission ? e : vec3(0.0)) + clamp(a, 0.0, 1.0) * l;
     uint h = pcgHash(randomSeed ^ pcgHash(uint(texel.x) | (uint(texel.y) << 16u)) ^ pcgHash(uint(texel.z) + 7919u));
     uint h1 = pcgHash(h), h2 = pcgHash(h1);

@@ -67,7 +67,7 @@ uniform uint randomSeed;
 // kept at every halfStride-th texel of each axis.
 layout(binding = BINDING_HALF_ACCUM, rg32ui) uniform coherent uimage2DArray halfAccum;
 uniform bool oddDirection;
-// Each front texel's first moments: the running means of L_in's channel sum
+// Each texel's first moments (a back side's at its layer): the running means of L_in's channel sum
 // times the sample's point (texels from its centre) and of the point itself,
 // folded at the accumulator's weights; lightmap/meta.frag makes them the slope
 // of the texel's light inside it, which the bundle pass reads at chart edges.
@@ -185,6 +185,14 @@ uvec2 foldSample(uvec2 stored, vec3 incoming, float w, uint h) {
     vec4 sum = vec4(state.rgb + (incoming - state.rgb) * (w / total), total);
     uint h1 = pcgHash(h), h2 = pcgHash(h1), h3 = pcgHash(h2);
     return encodeAccumulator(sum, vec4(uniform01(h), uniform01(h1), uniform01(h2), uniform01(h3)));
+}
+
+// The texel's moments with a sample at `point` folded in at weight w, beside
+// its accumulator `stored` (before the sample): the same running means.
+void foldMoments(ivec3 texel, uvec2 stored, vec3 incoming, float w, vec2 point) {
+    float share = w / (decodeAccumulator(stored).a + w);
+    vec4 moment = imageLoad(moments, texel);
+    imageStore(moments, texel, moment + (vec4(dot(incoming, vec3(1.0)) * point, point) - moment) * share);
 }
 #endif
 
@@ -623,11 +631,7 @@ void main() {
 #endif
     uint h = pcgHash(randomSeed ^ pcgHash(uint(texel.x) | (uint(texel.y) << 16u)) ^ pcgHash(uint(texel.z) + 7919u));
     uvec2 stored = imageLoad(accum, texel).rg;
-    if (s.flat_) {
-        float share = w / (decodeAccumulator(stored).a + w);
-        vec4 moment = imageLoad(moments, texel);
-        imageStore(moments, texel, moment + (vec4(dot(incoming, vec3(1.0)) * s.point, s.point) - moment) * share);
-    }
+    if (s.flat_) foldMoments(texel, stored, incoming, w, s.point);
     imageStore(accum, texel, uvec4(foldSample(stored, incoming, w, h), 0u, 0u));
 #ifdef BACK_SIDES
     // A double-sided triangle's back side: the nearest node the other way,
@@ -638,8 +642,9 @@ void main() {
         uint bestBackNode = nearestNode(pixel, self + (ahead ? -skip : skip), !ahead, ownSide);
         ivec3 back = ivec3(texel.xy, texel.z + backLayerOffset);
         vec3 incomingBack = incomingRadiance(bestBackNode, ownSide, ahead ? -bundleDir : bundleDir);
-        uvec2 folded = foldSample(imageLoad(accum, back).rg, incomingBack, w, pcgHash(h ^ 0x85ebca6bu));
-        imageStore(accum, back, uvec4(folded, 0u, 0u));
+        uvec2 storedBack = imageLoad(accum, back).rg;
+        if (s.flat_) foldMoments(back, storedBack, incomingBack, w, s.point);
+        imageStore(accum, back, uvec4(foldSample(storedBack, incomingBack, w, pcgHash(h ^ 0x85ebca6bu)), 0u, 0u));
     }
 #endif
     ivec3 half_;

@@ -70,6 +70,7 @@ struct LeafRecord {
 #define BINDING_MATERIAL_TEX 2   // texture unit: a material's albedo texture (emission: + 1)
 #define BINDING_READ_MODES 4     // texture unit: r8ui per texel: READ_* per axis (lightmap/read_modes.comp)
 #define BINDING_FOOTPRINT 5       // texture unit: rgb32ui per texel: its square's part on its chart (texelFootprints)
+#define BINDING_CHART_NEIGHBOURS 4  // texture unit, outgoing pass only: chartNeighbours (r8ui, CHART_NEIGHBOUR_*)
 #define BINDING_SLOPES 7         // texture unit: rgba16f per front texel: the slope of its light inside it (meta.frag)
 #define BINDING_TEXEL_CHARTS 6   // texture unit: r16ui per texel: its owner's chart, low 15 bits, and TEXEL_CURVED (mesh_layout.h)
 #define BINDING_CHART_NEIGHBOURS_IMAGE 6  // image unit, read-modes pass only (the dilation's unit elsewhere)
