@@ -65,7 +65,7 @@ struct BundleScene {
     GLuint radiance = 0;      // outgoing radiance per texel (the bundle pass reads it)
     GLuint readModes = 0;     // per texel, how the bundle pass reads its radiance (lightmap/read_modes.comp)
     GLuint texelCharts = 0;   // per page texel, its owner's chart (low 16 bits): a fragment reads its own chart's texels
-    GLuint slopes = 0;        // per front texel, the slope of its light inside it (lightmap/meta.frag); 0: none read
+    GLuint slopes = 0;        // per texel, the slope of its light inside it (lightmap/meta.frag); 0: none read
     GLuint pageFramebuffer = 0;
     int pageResolution = 0;
     // cut-outs (glsl/shared/material_layout.h): per material alpha and the masks' texels

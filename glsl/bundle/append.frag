@@ -110,8 +110,8 @@ vec3 radianceAt(vec2 uv, int page, int layer, uint chart) {
     vec3 read = clamp(m + axisOffset(modeX, l, m, r, f.x) + axisOffset(modeY, d, m, u, f.y), lo, hi);
     // Along an axis with no neighbour on the chart to take a slope from (a
     // chart's edge, a strip a texel wide), the slope measured inside the texel
-    // (meta.frag slopeInside), about its footprint's centroid, on its
-    // reflected light's colour, within the mean either way
+    // from its own samples (meta.frag slopeInside), about their mean point, in
+    // the texel's colour, within the mean either way
     float total = dot(m, vec3(1.0));
     if (slopesInside && (modeX == READ_NONE || modeY == READ_NONE) && total > 0.0) {
         vec4 inside = texelFetch(slopes, ivec3(c, layer), 0);

@@ -55,7 +55,7 @@ layout(binding = BINDING_CHART_NEIGHBOURS) uniform usampler2DArray chartNeighbou
 // L_in and the point, over the footprint's spread), times the albedo. Zero for
 // a curved texel (it keeps no moments: update.frag).
 vec4 slopeInside(ivec3 texel, vec3 a, vec3 m) {
-    // read only along an axis without a neighbour on the chart each way (read_modes.comp)
+    // the bundle pass reads it only along an axis that lacks a neighbour on the chart (READ_NONE)
     const uint everyNeighbour = CHART_NEIGHBOUR_LEFT | CHART_NEIGHBOUR_RIGHT | CHART_NEIGHBOUR_DOWN | CHART_NEIGHBOUR_UP;
     if ((texelFetch(chartNeighbours, ivec3(texel.xy, page), 0).r & everyNeighbour) == everyNeighbour) return vec4(0.0);
     vec4 moment = imageLoad(moments, texel);
