@@ -179,20 +179,27 @@ vec3 incomingRadiance(uint i, uint seen, vec3 look) {
 // `stored` (running mean M, weight W; lib/rounding.glsl's accumulator) with
 // L_in folded in at weight w: W += w, M += (L_in - M) w / W, rounded with the
 // random numbers of h.
-uvec2 foldSample(uvec2 stored, vec3 incoming, float w, uint h) {
-    vec4 state = decodeAccumulator(stored);
+uvec2 foldSample(vec4 state, vec3 incoming, float w, uint h) {
     float total = state.a + w;
     vec4 sum = vec4(state.rgb + (incoming - state.rgb) * (w / total), total);
     uint h1 = pcgHash(h), h2 = pcgHash(h1), h3 = pcgHash(h2);
     return encodeAccumulator(sum, vec4(uniform01(h), uniform01(h1), uniform01(h2), uniform01(h3)));
 }
 
-// The texel's moments with a sample at `point` folded in at weight w, beside
-// its accumulator `stored` (before the sample): the same running means.
-void foldMoments(ivec3 texel, uvec2 stored, vec3 incoming, float w, vec2 point) {
-    float share = w / (decodeAccumulator(stored).a + w);
-    vec4 moment = imageLoad(moments, texel);
-    imageStore(moments, texel, moment + (vec4(dot(incoming, vec3(1.0)) * point, point) - moment) * share);
+uvec2 foldSample(uvec2 stored, vec3 incoming, float w, uint h) {
+    return foldSample(decodeAccumulator(stored), incoming, w, h);
+}
+
+// Texel `texel`'s accumulator with L_in folded in (foldSample) and, for a
+// flat texel's sample at `point`, its moments at the same weights.
+void foldTexel(ivec3 texel, vec3 incoming, float w, uint h, bool flat_, vec2 point) {
+    vec4 state = decodeAccumulator(imageLoad(accum, texel).rg);
+    if (flat_) {
+        vec4 moment = imageLoad(moments, texel);
+        float share = w / (state.a + w);
+        imageStore(moments, texel, moment + (vec4(dot(incoming, vec3(1.0)) * point, point) - moment) * share);
+    }
+    imageStore(accum, texel, uvec4(foldSample(state, incoming, w, h), 0u, 0u));
 }
 #endif
 
@@ -630,9 +637,7 @@ void main() {
     return;
 #endif
     uint h = pcgHash(randomSeed ^ pcgHash(uint(texel.x) | (uint(texel.y) << 16u)) ^ pcgHash(uint(texel.z) + 7919u));
-    uvec2 stored = imageLoad(accum, texel).rg;
-    if (s.flat_) foldMoments(texel, stored, incoming, w, s.point);
-    imageStore(accum, texel, uvec4(foldSample(stored, incoming, w, h), 0u, 0u));
+    foldTexel(texel, incoming, w, h, s.flat_, s.point);
 #ifdef BACK_SIDES
     // A double-sided triangle's back side: the nearest node the other way,
     // which it sees along the same line at the same cosine, into its own
@@ -642,9 +647,7 @@ void main() {
         uint bestBackNode = nearestNode(pixel, self + (ahead ? -skip : skip), !ahead, ownSide);
         ivec3 back = ivec3(texel.xy, texel.z + backLayerOffset);
         vec3 incomingBack = incomingRadiance(bestBackNode, ownSide, ahead ? -bundleDir : bundleDir);
-        uvec2 storedBack = imageLoad(accum, back).rg;
-        if (s.flat_) foldMoments(back, storedBack, incomingBack, w, s.point);
-        imageStore(accum, back, uvec4(foldSample(storedBack, incomingBack, w, pcgHash(h ^ 0x85ebca6bu)), 0u, 0u));
+        foldTexel(back, incomingBack, w, pcgHash(h ^ 0x85ebca6bu), s.flat_, s.point);
     }
 #endif
     ivec3 half_;
