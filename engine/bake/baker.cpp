@@ -472,12 +472,12 @@ void Baker::Impl::coveragePass() {
         gl::writeTexture(texelCharts.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_SHORT, 2, ownerCharts.data());
         stats.sharedTexels += texels.shared;
         {
-            std::vector<glm::uvec3> packed(footprints.size());
+            std::vector<glm::uvec4> packed(footprints.size());
             for (size_t i = 0; i < packed.size(); ++i) {
                 const TexelFootprint& f = footprints[i];
-                packed[i] = glm::uvec3(uint32_t(f.cells), uint32_t(f.cells >> 32), f.edge | uint32_t(f.area) << 24);
+                packed[i] = glm::uvec4(uint32_t(f.cells), uint32_t(f.cells >> 32), f.edge | uint32_t(f.area) << 24, f.spread);
             }
-            gl::writeTexture(footprint.id(), 0, 0, p, res, res, 1, GL_RGB_INTEGER, GL_UNSIGNED_INT, 12, packed.data());
+            gl::writeTexture(footprint.id(), 0, 0, p, res, res, 1, GL_RGBA_INTEGER, GL_UNSIGNED_INT, 16, packed.data());
         }
         gl::writeTexture(chartNeighbours.id(), 0, 0, p, res, res, 1, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1,
                          neighbours.data());
@@ -738,7 +738,7 @@ Status Baker::Impl::init(const Scene& scene) {
         direct = gl::Texture::create2DArray("direct light (fp16)", GL_RGBA16F, res, res, pages);
         dilation = gl::Texture::create2DArray("dilation codes", GL_R8UI, res, res, pages);
         chartNeighbours = gl::Texture::create2DArray("same-chart neighbours", GL_R8UI, res, res, pages);
-        footprint = gl::Texture::create2DArray("texel footprints on their charts", GL_RGB32UI, res, res, pages);
+        footprint = gl::Texture::create2DArray("texel footprints on their charts", GL_RGBA32UI, res, res, pages);
         texelCharts = gl::Texture::create2DArray("texel owners' charts", GL_R16UI, res, res, pages);
         readModes = gl::Texture::create2DArray("radiance read modes", GL_R8UI, res, res, stateLayers());
         moments = gl::Texture::create2DArray("texels' first moments", GL_RGBA32F, res, res, stateLayers());

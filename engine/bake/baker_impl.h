@@ -62,15 +62,15 @@ struct Baker::Impl {
     // GL objects
     gl::Buffer vertexBuffer, triangleBuffer, metaIndexBuffer;
     gl::VertexArray vao;
-    // Light-map state, per page texel (61 bytes, 98 with back sides; BakeStats::memory):
+    // Light-map state, per page texel (65 bytes, 102 with back sides; BakeStats::memory):
     //   accum      RG32UI  the running mean of incoming radiance and its weight (lib/rounding.glsl's accumulator)
     //   radiance   RGB9_E5 outgoing radiance Lo the bundle pass samples (meta.frag writes it)
     //   direct     RGBA16F direct light L_lm (sun + explicit emitters)
     //   dilation   R8UI    the covered texel each texel shows (DILATION_* codes)
     //   chartNeighbours R8UI the texels 1 and 2 away along its row and column on its chart (CHART_NEIGHBOUR_*)
     //   readModes  R8UI    how the bundle pass reads the radiance inside the texel (READ_* per axis)
-    //   footprint  RGB32UI which part of its square lies on its chart: eighth-texel cells, one more border
-    //                      edge and the part's area (texelFootprints)
+    //   footprint  RGBA32UI which part of its square lies on its chart: eighth-texel cells, one more border
+    //                      edge, the part's area and its spread (texelFootprints)
     //   texelCharts R16UI  its owner's chart, low 16 bits (TRIANGLE_CHART_SHIFT; read by the bundle pass)
     //   moments    RGBA32F the texel's first moments: the running means of L_in's sum times its
     //                      sample's point and of the point (update.frag)

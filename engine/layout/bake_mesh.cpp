@@ -95,6 +95,23 @@ double polygonArea(const std::vector<glm::dvec2>& poly) {
     return 0.5 * area2;
 }
 
+// A counter-clockwise polygon's area integrals of 1, x, y, x^2, xy and y^2.
+struct AreaMoments {
+    double a = 0.0, x = 0.0, y = 0.0, xx = 0.0, xy = 0.0, yy = 0.0;
+};
+void addAreaMoments(const std::vector<glm::dvec2>& poly, AreaMoments& m) {
+    for (size_t k = 0; k < poly.size(); ++k) {
+        const glm::dvec2 &p = poly[k], &q = poly[(k + 1) % poly.size()];
+        const double c = p.x * q.y - q.x * p.y;
+        m.a += c / 2.0;
+        m.x += (p.x + q.x) * c / 6.0;
+        m.y += (p.y + q.y) * c / 6.0;
+        m.xx += (p.x * p.x + p.x * q.x + q.x * q.x) * c / 12.0;
+        m.yy += (p.y * p.y + p.y * q.y + q.y * q.y) * c / 12.0;
+        m.xy += (p.x * q.y + 2.0 * p.x * p.y + 2.0 * q.x * q.y + q.x * p.y) * c / 24.0;
+    }
+}
+
 // A convex polygon clipped to the half-plane n . p <= d (Sutherland-Hodgman).
 std::vector<glm::dvec2> clipHalfPlane(const std::vector<glm::dvec2>& poly, glm::dvec2 n, double d) {
     std::vector<glm::dvec2> out;
@@ -401,6 +418,12 @@ uint32_t encodeFootprintEdge(int angle, double distance) {
     return std::max(uint32_t(angle & 4095) | uint32_t(d) << 12, 1u << 12);  // 0 stays "none"
 }
 
+uint32_t encodeFootprintSpread(double xx, double xy, double yy) {
+    const auto level = [](double v, int levels) { return uint32_t(std::clamp(int(std::lround(v)), 0, levels)); };
+    const uint32_t x = std::max(level(xx * 12.0 * 2047.0, 2047), 1u), y = std::max(level(yy * 12.0 * 2047.0, 2047), 1u);
+    return x | y << 11 | level((xy * 12.0 + 1.0) * 0.5 * 1022.0, 1022) << 22;
+}
+
 namespace {
 // An edge's half-plane n . p <= d, decoded as lib/texel_footprint.glsl does (in float).
 std::pair<glm::dvec2, double> decodeFootprintEdge(uint32_t code) {
@@ -513,25 +536,40 @@ std::vector<TexelFootprint> texelFootprints(const BakeMesh& mesh, int page, int 
         // the accepted part's area, exactly: each cell clipped to the owner's
         // border edges and the edge
         if (best != 0) halfPlanes.push_back(decodeFootprintEdge(best));
-        double accepted = 0.0;
+        AreaMoments accepted;  // and how it spreads
         for (int cell = 0; cell < 64; ++cell) {
             if (!((mask[i] >> cell) & 1u)) continue;
             const double x0 = (cell % 8) / 8.0 - 0.5, y0 = (cell / 8) / 8.0 - 0.5, s = 1.0 / 8.0;
             std::vector<glm::dvec2> poly = {{x0, y0}, {x0 + s, y0}, {x0 + s, y0 + s}, {x0, y0 + s}};
             for (const auto& [n, d] : halfPlanes) poly = clipHalfPlane(poly, n, d);
-            accepted += polygonArea(poly);
+            addAreaMoments(poly, accepted);
         }
         out[i].edge = best;
-        out[i].area = uint8_t(std::lround(255.0 * accepted));
+        out[i].area = uint8_t(std::lround(255.0 * accepted.a));
+        if (accepted.a > 0.0) {
+            const double mx = accepted.x / accepted.a, my = accepted.y / accepted.a;
+            out[i].spread = encodeFootprintSpread(accepted.xx / accepted.a - mx * mx, accepted.xy / accepted.a - mx * my,
+                                                  accepted.yy / accepted.a - my * my);
+        }
         // how far the test (with the edge) is from the chart, on the grid
         const std::pair<glm::dvec2, double> side = decodeFootprintEdge(best);
         int on = 0, wrong = 0;
+        glm::dvec3 sums(0.0), squares(0.0);  // the chart's points: n, x, y; xx, xy, yy
         for (int k = 0; k < N * N; ++k) {
             const bool taken = base[size_t(k)] && (best == 0 || within(side, point(k)));
             on += exact[size_t(k)];
             wrong += taken != bool(exact[size_t(k)]);
+            const glm::dvec2 q = point(k);
+            if (exact[size_t(k)]) sums += glm::dvec3(1.0, q.x, q.y), squares += glm::dvec3(q.x * q.x, q.x * q.y, q.y * q.y);
         }
         out[i].inexact = wrong > kInexactFootprintShare * on;
+        if (out[i].inexact && on > 0) {
+            // its samples take the points its triangles hold: their spread, each grid point's own 1 / (12 N^2) added
+            const glm::dvec3 mean = sums / sums.x, second = squares / sums.x;
+            const double own = 1.0 / (12.0 * N * N);
+            out[i].spread = encodeFootprintSpread(second.x - mean.y * mean.y + own, second.y - mean.y * mean.z,
+                                                  second.z - mean.z * mean.z + own);
+        }
         for (int k = 0; k < N * N; ++k) out[i].sixteenths[size_t((k % N) * 4 / N + (k / N) * 4 / N * 4)] += exact[size_t(k)];
         if (out[i].inexact) out[i].area = uint8_t(std::lround(255.0 * on / (N * N)));
     }

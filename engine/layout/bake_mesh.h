@@ -161,6 +161,12 @@ struct TexelFootprint {
     // its k x k texels in a supersampled bake weighs in it (part;
     // bake/supersample.h).
     std::array<uint8_t, 16> sixteenths{};
+    // How the points the test takes spread over the square: the covariance of
+    // the accepted part (encodeFootprintSpread; an inexact texel's, of its
+    // triangles' points on the grid); the slope of a texel's light inside it divides by it
+    // (lightmap/meta.frag slopeInside). 0: none measured (a texel whose eight
+    // neighbours are on its chart): the cells' spread (lib/texel_footprint.glsl).
+    uint32_t spread = 0;
     // The points in texel (x, y) of its k x k (k 1, 2 or 4)
     int part(int k, int x, int y) const {
         int sum = 0;
@@ -182,6 +188,10 @@ std::vector<TexelFootprint> texelFootprints(const BakeMesh& mesh, int page, int 
 // border stands the wall it meets, whose fragments pass for the ledge's own
 // within the update pass's depth tolerance). 0 is none (everything inside).
 uint32_t encodeFootprintEdge(int angle, double distance);
+// A covariance (xx, xy, yy, in texels^2) as 32 bits: xx and yy in 11 bits
+// each over [0, 1/12], xy in 10 over [-1/12, 1/12] in 1022 steps (0 exact);
+// never 0 (lib/texel_footprint.glsl decodeFootprintSpread).
+uint32_t encodeFootprintSpread(double xx, double xy, double yy);
 double footprintEdgeAngle(int angle);  // radians of an encoded angle (0..4095)
 bool insideFootprintEdge(uint32_t code, glm::dvec2 offset);
 

@@ -63,6 +63,7 @@ float footprintArea(uvec3 footprint) { return max(float(footprint.z >> 24u), 1.0
 // that touch the chart (`cells`, cellOnChart's; the whole square if none), in
 // texels: how a texel's samples spread, for the slope of its light inside it
 // (lightmap/meta.frag). Sums over the cells' columns and rows by bit counts.
+// (The covariance measured at setup where there is one, decodeFootprintSpread.)
 vec3 footprintSpread(uvec2 cells) {
     if (cells == uvec2(0u) || cells == uvec2(0xffffffffu)) return vec3(1.0 / 12.0, 0.0, 1.0 / 12.0);
     float n = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0, syy = 0.0;
@@ -83,6 +84,14 @@ vec3 footprintSpread(uvec2 cells) {
     vec2 mean = vec2(sx, sy) / n;
     return vec3(sxx / n - mean.x * mean.x, sxy / n - mean.x * mean.y, syy / n - mean.y * mean.y) / 64.0 +
            vec3(1.0 / 768.0, 0.0, 1.0 / 768.0);
+}
+
+// The spread of the points a texel's samples take (xx, xy, yy; layout/
+// bake_mesh.h TexelFootprint::spread, encodeFootprintSpread), from its
+// footprint texel; the cells' where none was measured.
+vec3 decodeFootprintSpread(uvec4 f) {
+    if (f.w == 0u) return footprintSpread(f.xy);
+    return vec3(float(f.w & 0x7ffu) / 2047.0, float(f.w >> 22u) / 1022.0 * 2.0 - 1.0, float((f.w >> 11u) & 0x7ffu) / 2047.0) / 12.0;
 }
 
 #ifdef CURVED_FOOTPRINT

@@ -63,7 +63,7 @@ vec4 slopeInside(ivec3 texel, vec3 a, vec3 m) {
     if (moment == vec4(0.0) || total <= 0.0) return vec4(0.0);
     vec2 mid = moment.zw;  // the samples' mean point
     vec2 covariance = moment.xy - total * mid;
-    vec3 spread = footprintSpread(texelFetch(footprint, ivec3(texel.xy, page), 0).xy);
+    vec3 spread = decodeFootprintSpread(texelFetch(footprint, ivec3(texel.xy, page), 0));
     vec2 slope = inverse(mat2(spread.x, spread.y, spread.y, spread.z)) * covariance;
     return vec4(slope * (dot(clamp(a, 0.0, 1.0), m) / total), mid);
 }

@@ -45,6 +45,27 @@ TEST(TexelFootprints, AStripNarrowerThanATexelTakesItsOwnWidth) {
     EXPECT_NE(f[5 * 16 + 5].edge, 0u) << "the far edge cuts texel 5's cells";
 }
 
+// The strip's texels' spread is the strip's own (0.1 texel tall: 0.1^2 / 12
+// across it, 1/12 along it), not its cell row's (1/8 tall, 1.6 times more
+// across): the slope of a texel's light inside it divides by it (meta.frag
+// slopeInside), and with the cells' a strip's slope read about a third low.
+TEST(TexelFootprints, AStripsSpreadIsItsOwnNotItsCells) {
+    const BakeMesh m = stripMesh();
+    const std::vector<int32_t> owners = texelOwners(m, 0, 16);
+    const std::vector<TexelFootprint> f = texelFootprints(m, 0, 16, owners, findLightmapCharts(m));
+    for (int x = 2; x < 6; ++x) {
+        const uint32_t code = f[5 * 16 + size_t(x)].spread;
+        ASSERT_NE(code, 0u) << "texel " << x;
+        // as lib/texel_footprint.glsl decodeFootprintSpread reads it
+        const double xx = (code & 0x7ffu) / 2047.0 / 12.0, yy = ((code >> 11) & 0x7ffu) / 2047.0 / 12.0;
+        const double xy = ((code >> 22) / 1022.0 * 2.0 - 1.0) / 12.0;
+        std::printf("[footprint] texel %d: spread xx %.5f xy %+.5f yy %.5f\n", x, xx, xy, yy);
+        EXPECT_NEAR(xx, 1.0 / 12.0, 0.004) << "texel " << x;
+        EXPECT_NEAR(yy, 0.01 / 12.0, 0.00005) << "texel " << x;
+        EXPECT_NEAR(xy, 0.0, 0.0001) << "texel " << x;
+    }
+}
+
 // The half-plane's encoding rounds inward: points up to 0.002 texel inside
 // its line may be left out, none past it is taken in.
 TEST(TexelFootprints, EdgeEncodingRoundsInward) {
