@@ -88,10 +88,14 @@ vec3 footprintSpread(uvec2 cells) {
 
 // The spread of the points a texel's samples take (xx, xy, yy; layout/
 // bake_mesh.h TexelFootprint::spread, encodeFootprintSpread), from its
-// footprint texel; the cells' where none was measured.
+// footprint texel; the cells' where none was measured. |xy| is kept under
+// sqrt(xx yy): a strip a few hundredths of a texel wide along a diagonal has
+// a determinant smaller than xy's rounding, which could flip its sign.
 vec3 decodeFootprintSpread(uvec4 f) {
     if (f.w == 0u) return footprintSpread(f.xy);
-    return vec3(float(f.w & 0x7ffu) / 2047.0, float(f.w >> 22u) / 1022.0 * 2.0 - 1.0, float((f.w >> 11u) & 0x7ffu) / 2047.0) / 12.0;
+    vec3 s = vec3(float(f.w & 0x7ffu) / 2047.0, float(f.w >> 22u) / 1022.0 * 2.0 - 1.0, float((f.w >> 11u) & 0x7ffu) / 2047.0) / 12.0;
+    float bound = 0.99 * sqrt(s.x * s.z);
+    return vec3(s.x, clamp(s.y, -bound, bound), s.z);
 }
 
 #ifdef CURVED_FOOTPRINT
