@@ -554,21 +554,25 @@ std::vector<TexelFootprint> texelFootprints(const BakeMesh& mesh, int page, int 
         // how far the test (with the edge) is from the chart, on the grid
         const std::pair<glm::dvec2, double> side = decodeFootprintEdge(best);
         int on = 0, wrong = 0;
-        glm::dvec3 sums(0.0), squares(0.0);  // the chart's points: n, x, y; xx, xy, yy
         for (int k = 0; k < N * N; ++k) {
             const bool taken = base[size_t(k)] && (best == 0 || within(side, point(k)));
             on += exact[size_t(k)];
             wrong += taken != bool(exact[size_t(k)]);
-            const glm::dvec2 q = point(k);
-            if (exact[size_t(k)]) sums += glm::dvec3(1.0, q.x, q.y), squares += glm::dvec3(q.x * q.x, q.x * q.y, q.y * q.y);
         }
         out[i].inexact = wrong > kInexactFootprintShare * on;
         if (out[i].inexact && on > 0) {
             // its samples take the points its triangles hold: their spread, each grid point's own 1 / (12 N^2) added
-            const glm::dvec3 mean = sums / sums.x, second = squares / sums.x;
+            glm::dvec2 mean(0.0);
+            glm::dvec3 second(0.0);  // xx, xy, yy
+            for (int k = 0; k < N * N; ++k)
+                if (exact[size_t(k)]) {
+                    const glm::dvec2 q = point(k);
+                    mean += q / double(on);
+                    second += glm::dvec3(q.x * q.x, q.x * q.y, q.y * q.y) / double(on);
+                }
             const double own = 1.0 / (12.0 * N * N);
-            out[i].spread = encodeFootprintSpread(second.x - mean.y * mean.y + own, second.y - mean.y * mean.z,
-                                                  second.z - mean.z * mean.z + own);
+            out[i].spread = encodeFootprintSpread(second.x - mean.x * mean.x + own, second.y - mean.x * mean.y,
+                                                  second.z - mean.y * mean.y + own);
         }
         for (int k = 0; k < N * N; ++k) out[i].sixteenths[size_t((k % N) * 4 / N + (k / N) * 4 / N * 4)] += exact[size_t(k)];
         if (out[i].inexact) out[i].area = uint8_t(std::lround(255.0 * on / (N * N)));
@@ -577,6 +581,7 @@ std::vector<TexelFootprint> texelFootprints(const BakeMesh& mesh, int page, int 
         out[i].cells = mask[i];
         if (owner[i] >= 0 && mask[i] == ~uint64_t(0)) {
             out[i].area = 255;
+            out[i].spread = encodeFootprintSpread(1.0 / 12.0, 0.0, 1.0 / 12.0);
             out[i].sixteenths.fill(N * N / 16);
         }
     }

@@ -163,9 +163,9 @@ struct TexelFootprint {
     std::array<uint8_t, 16> sixteenths{};
     // How the points the test takes spread over the square: the covariance of
     // the accepted part (encodeFootprintSpread; an inexact texel's, of its
-    // triangles' points on the grid); the slope of a texel's light inside it divides by it
-    // (lightmap/meta.frag slopeInside). 0: none measured (a texel whose eight
-    // neighbours are on its chart): the cells' spread (lib/texel_footprint.glsl).
+    // triangles' points on the grid; the whole square's where every cell is
+    // on the chart); the slope of a texel's light inside it divides by it
+    // (lightmap/meta.frag slopeInside). 0: none (uncovered, or no part accepted).
     uint32_t spread = 0;
     // The points in texel (x, y) of its k x k (k 1, 2 or 4)
     int part(int k, int x, int y) const {

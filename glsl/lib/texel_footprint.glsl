@@ -59,40 +59,13 @@ bool insideFootprintEdge(uint code, vec2 offset) {
 // The part of the texel's square the footprint test takes as on its chart (0..1).
 float footprintArea(uvec3 footprint) { return max(float(footprint.z >> 24u), 1.0) / 255.0; }
 
-// The covariance (xx, xy, yy) of a point uniform over the eighth-texel cells
-// that touch the chart (`cells`, cellOnChart's; the whole square if none), in
-// texels: how a texel's samples spread, for the slope of its light inside it
-// (lightmap/meta.frag). Sums over the cells' columns and rows by bit counts.
-// (The covariance measured at setup where there is one, decodeFootprintSpread.)
-vec3 footprintSpread(uvec2 cells) {
-    if (cells == uvec2(0u) || cells == uvec2(0xffffffffu)) return vec3(1.0 / 12.0, 0.0, 1.0 / 12.0);
-    float n = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0, syy = 0.0;
-    for (uint row = 0u; row < 8u; ++row) {
-        uint bits = ((row < 4u ? cells.x : cells.y) >> (8u * (row & 3u))) & 0xffu;
-        // the row's count, the sum of its cells' indices i = b0 + 2 b1 + 4 b2
-        // and of their squares b0 + 4 b1 + 16 b2 + 4 b0 b1 + 8 b0 b2 + 16 b1 b2
-        float count = float(bitCount(bits));
-        float index = float(bitCount(bits & 0xaau) + 2 * bitCount(bits & 0xccu) + 4 * bitCount(bits & 0xf0u));
-        float square = float(bitCount(bits & 0xaau) + 4 * bitCount(bits & 0xccu) + 16 * bitCount(bits & 0xf0u) +
-                             4 * bitCount(bits & 0x88u) + 8 * bitCount(bits & 0xa0u) + 16 * bitCount(bits & 0xc0u));
-        float y = float(row);
-        n += count, sy += count * y, syy += count * y * y;
-        sx += index, sxx += square, sxy += index * y;
-    }
-    // cell index i is at (i + 1/2) / 8 - 1/2 texels: the covariance of the
-    // indices / 64, and each cell's own spread (uniform over an eighth: 1 / 768)
-    vec2 mean = vec2(sx, sy) / n;
-    return vec3(sxx / n - mean.x * mean.x, sxy / n - mean.x * mean.y, syy / n - mean.y * mean.y) / 64.0 +
-           vec3(1.0 / 768.0, 0.0, 1.0 / 768.0);
-}
-
 // The spread of the points a texel's samples take (xx, xy, yy; layout/
 // bake_mesh.h TexelFootprint::spread, encodeFootprintSpread), from its
-// footprint texel; the cells' where none was measured. |xy| is kept under
+// footprint texel; the whole square's where none was. |xy| is kept under
 // sqrt(xx yy): a strip a few hundredths of a texel wide along a diagonal has
 // a determinant smaller than xy's rounding, which could flip its sign.
 vec3 decodeFootprintSpread(uvec4 f) {
-    if (f.w == 0u) return footprintSpread(f.xy);
+    if (f.w == 0u) return vec3(1.0 / 12.0, 0.0, 1.0 / 12.0);
     vec3 s = vec3(float(f.w & 0x7ffu) / 2047.0, float(f.w >> 22u) / 1022.0 * 2.0 - 1.0, float((f.w >> 11u) & 0x7ffu) / 2047.0) / 12.0;
     float bound = 0.99 * sqrt(s.x * s.z);
     return vec3(s.x, clamp(s.y, -bound, bound), s.z);
