@@ -240,6 +240,9 @@ struct ReferenceBaker::Impl {
     Status init(const Scene& scene);
     void findTexels();
     SurfacePoint footprintPoint(const Texel& texel, float u1, float u2) const;
+    template <class F>
+    void forEachTexel(F&& f);
+    glm::dvec4 texelSamples(size_t i, uint64_t seed, uint32_t first, uint32_t count, Counters& c) const;
     void runPass(int first, int count);
     glm::vec3 sample(const SurfacePoint& start, uint32_t sampleIndex, uint64_t key, const Scrambles& s,
                      Counters& counters) const;
@@ -681,7 +684,10 @@ glm::vec3 ReferenceBaker::Impl::sample(const SurfacePoint& start, uint32_t sampl
     return radiance;
 }
 
-void ReferenceBaker::Impl::runPass(int first, int count) {
+// Calls f(i, counters) for every texel i, on options.threads threads (chunks of
+// 16 texels handed out in turn), and adds the threads' counters to the stats.
+template <class F>
+void ReferenceBaker::Impl::forEachTexel(F&& f) {
     const size_t chunk = 16;
     std::atomic<size_t> next{0};
     std::vector<Counters> counters(size_t(options.threads));
@@ -695,21 +701,7 @@ void ReferenceBaker::Impl::runPass(int first, int count) {
             size_t begin = next.fetch_add(chunk);
             if (begin >= texels.size()) break;
             size_t end = std::min(begin + chunk, texels.size());
-            for (size_t i = begin; i < end; ++i) {
-                const Texel& texel = texels[i];
-                const uint64_t key = hash(options.seed, texel.page, texel.index);
-                const Scrambles s = makeScrambles(key);
-                glm::dvec3 sum = sums[i];
-                for (int k = 0; k < count; ++k) {
-                    const uint32_t index = uint32_t(first + k);
-                    const SurfacePoint start = footprintPoint(texel, unit(owenScramble(sobol(index, SOBOL2), s.pos0)),
-                                                              unit(owenScramble(sobol(index, SOBOL3), s.pos1)));
-                    glm::vec3 value = sample(start, index, key, s, c);
-                    if (std::isfinite(value.x) && std::isfinite(value.y) && std::isfinite(value.z))
-                        sum += glm::dvec3(value);
-                }
-                sums[i] = sum;
-            }
+            for (size_t i = begin; i < end; ++i) f(i, c);
         }
     };
     std::vector<std::thread> pool;
@@ -721,6 +713,32 @@ void ReferenceBaker::Impl::runPass(int first, int count) {
         stats.rays += c.rays;
         stats.shadowRays += c.shadowRays;
     }
+}
+
+// Samples [first, first + count) of texel i's stream `seed`: their sum, and
+// the sum of the squares of their channels' mean.
+glm::dvec4 ReferenceBaker::Impl::texelSamples(size_t i, uint64_t seed, uint32_t first, uint32_t count,
+                                              Counters& c) const {
+    const Texel& texel = texels[i];
+    const uint64_t key = hash(seed, texel.page, texel.index);
+    const Scrambles s = makeScrambles(key);
+    glm::dvec4 sum(0.0);
+    for (uint32_t index = first; index < first + count; ++index) {
+        const SurfacePoint start = footprintPoint(texel, unit(owenScramble(sobol(index, SOBOL2), s.pos0)),
+                                                  unit(owenScramble(sobol(index, SOBOL3), s.pos1)));
+        glm::vec3 value = sample(start, index, key, s, c);
+        if (std::isfinite(value.x) && std::isfinite(value.y) && std::isfinite(value.z)) {
+            const double mean = (double(value.x) + value.y + value.z) / 3.0;
+            sum += glm::dvec4(glm::dvec3(value), mean * mean);
+        }
+    }
+    return sum;
+}
+
+void ReferenceBaker::Impl::runPass(int first, int count) {
+    forEachTexel([&](size_t i, Counters& c) {
+        sums[i] += glm::dvec3(texelSamples(i, options.seed, uint32_t(first), uint32_t(count), c));
+    });
 }
 
 ReferenceBaker::ReferenceBaker(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -771,6 +789,21 @@ LightmapPages ReferenceBaker::readLightmaps() const {
         out.pages.push_back(dilatedImage(std::move(map), res, m.layout.padding + 1));
         out.covered.push_back(std::move(cov));
     }
+    return out;
+}
+
+std::vector<TexelId> ReferenceBaker::coveredTexels() const {
+    std::vector<TexelId> out;
+    out.reserve(impl_->texels.size());
+    for (const Texel& t : impl_->texels) out.push_back({t.page, t.index});
+    return out;
+}
+
+std::vector<glm::dvec4> ReferenceBaker::sampleTexels(uint64_t seed, const std::vector<uint32_t>& spp) {
+    Impl& m = *impl_;
+    CHECK_EQ(spp.size(), m.texels.size());
+    std::vector<glm::dvec4> out(m.texels.size());
+    m.forEachTexel([&](size_t i, Counters& c) { out[i] = m.texelSamples(i, seed, 0, spp[i], c); });
     return out;
 }
 

@@ -77,6 +77,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
@@ -89,6 +90,11 @@
 #include "scene/scene.h"
 
 namespace bb {
+
+struct TexelId {
+    uint32_t page = 0;
+    uint32_t index = 0;  // y * resolution + x
+};
 
 struct ReferenceOptions {
     int spp = 1024;                 // samples (paths) per texel in all; typ. 64 .. 65536
@@ -147,6 +153,17 @@ public:
     // on the side `normal` faces, from `spp` samples of stream `stream`
     // (single-threaded). `normal` is used as both shading and geometric normal.
     glm::vec3 estimate(const glm::vec3& point, const glm::vec3& normal, int spp, uint64_t stream) const;
+
+    // The covered texels, in the order sampleTexels() takes and returns them.
+    std::vector<TexelId> coveredTexels() const;
+
+    // Estimates independent of the progressive ones (the bake's error check,
+    // reference/error_check.h): for covered texel i, samples [0, spp[i]) of its
+    // stream under `seed` (another seed than options.seed: independent of
+    // readLightmaps()), as step() traces them (on options.threads threads):
+    // xyz their sum, w the sum of the squares of their channels' mean. Any
+    // prefix of a texel's stream is an unbiased estimate of its value.
+    std::vector<glm::dvec4> sampleTexels(uint64_t seed, const std::vector<uint32_t>& spp);
 
     const ReferenceStats& stats() const;
     const BakeMesh& mesh() const;

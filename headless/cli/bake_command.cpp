@@ -18,6 +18,7 @@
 #include "headless/cli/progress.h"
 #include "headless/mpi/mpi_share.h"
 #include "headless/platform.h"
+#include "reference/error_check.h"
 
 namespace bb::cli {
 namespace {
@@ -92,6 +93,18 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
                    "at most this (e.g. 0.01; checked at radiance refreshes from 16 directions on; --directions is then "
                    "the most); 0 = off")
         ->check(CLI::Range(0.0, 1.0))
+        ->capture_default_str();
+    cmd.add_option("--error-check", a.errorCheck,
+                   "After the bake, estimate its error against the truth with the CPU path tracer: two independent "
+                   "estimates of every texel of N paths each on average, where the reference is noisiest most "
+                   "(stats.json noise.check; unbiased, bias and noise alike); auto = directions / 8 (16 to 512), off")
+        ->check([](const std::string& v) -> std::string {
+            if (v == "auto" || v == "off") return {};
+            char* end = nullptr;
+            const long n = std::strtol(v.c_str(), &end, 10);
+            return end != v.c_str() && *end == 0 && n >= 1 && n <= (1 << 20) ? std::string{}
+                                                                             : "must be auto, off or 1 to 1048576";
+        })
         ->capture_default_str();
     addSeamsOption(cmd, a.seams);
     cmd.add_option("--checkpoint-every", a.checkpointEvery,
@@ -243,7 +256,8 @@ int runBake(const BakeArgs& args) {
                      {"history_plateau", (*baker)->stats().historyPlateau},
                      {"direct", args.direct}, {"emitter_samples", args.emitterSamples},
                      {"sun_jitter", args.sunJitter}, {"resolution_probe", args.resolutionProbe},
-                     {"seams", args.seams}, {"supersample", args.supersample}, {"mpi_ranks", mpi ? mpi->count() : 1}, {"target_noise", args.targetNoise}};
+                     {"seams", args.seams}, {"supersample", args.supersample}, {"mpi_ranks", mpi ? mpi->count() : 1}, {"target_noise", args.targetNoise},
+                     {"error_check", args.errorCheck}};
     info.wallSeconds = seconds;
     info.writePreviews = args.preview;
     LightmapPages maps = (*baker)->readLightmaps();  // before the stats: its read-back memory counts
@@ -251,6 +265,22 @@ int runBake(const BakeArgs& args) {
     if (mpi) stats["mpi"] = mpiFigures;
     if (args.seams == "stitch")
         stats["seams"] = stitchSeams(maps, findSeams((*baker)->mesh(), maps.resolution)).toJson();
+    if (args.errorCheck != "off") {  // on the maps as written
+        ErrorCheckOptions check;
+        check.reference.seed = args.seed;
+        check.reference.sky = options.sky;
+        check.reference.environment = options.environment;
+        check.reference.threads = 0;
+        check.stitchSeams = args.seams == "stitch";
+        check.spp = args.errorCheck == "auto" ? std::clamp((*baker)->progress().directionsDone / 8, 16, 512)
+                                              : std::atoi(args.errorCheck.c_str());
+        auto result = checkError(loaded->scene, loaded->layout, maps, check);
+        if (!result) return fail(result.error());
+        stats["noise"]["check"] = result->toJson();
+        stats["noise"]["check"]["spp"] = check.spp;
+        if (result->conclusive()) stats["noise"]["error_estimate"] = result->relRmse;
+        logInfo(result->summary());
+    }
     if (Status s = writeBakeOutputs(args.outDir, loaded->scene, loaded->layout, maps, stats, info); !s)
         return fail(s.message());
     if (args.checkpointEvery > 0 || args.resume) std::filesystem::remove(checkpoint);  // the outputs supersede it

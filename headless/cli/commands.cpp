@@ -27,6 +27,7 @@ int run(int argc, char** argv) {
     addReferenceCommand(app, action);
     addCompareCommand(app, action);
     addExportCommand(app, action);
+    addCheckCommand(app, action);
 
     try {
         app.parse(argc, argv);

@@ -45,6 +45,7 @@ struct BakeArgs {
     int checkpointEvery = 0;
     bool resume = false;
     double targetNoise = 0;           // > 0: stop at this estimated relative noise
+    std::string errorCheck = "auto";  // paths per texel of the path-traced error check: auto, off or a number
     std::string rounding = "stochastic";
     float historyPower = -1.0f;
     int historyPlateau = 0;
@@ -114,6 +115,7 @@ void addRenderCommand(CLI::App& app, std::function<int()>& action);     // rende
 void addReferenceCommand(CLI::App& app, std::function<int()>& action);  // reference_command.cpp
 void addCompareCommand(CLI::App& app, std::function<int()>& action);    // compare_command.cpp
 void addExportCommand(CLI::App& app, std::function<int()>& action);     // export_command.cpp
+void addCheckCommand(CLI::App& app, std::function<int()>& action);      // check_command.cpp
 
 int runInfo(const InfoArgs& args);
 int runBake(const BakeArgs& args);

@@ -1,0 +1,118 @@
+// The bake's error from two independent reference estimates: see error_check.h.
+#include "reference/error_check.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "bake/seam_stitch.h"
+#include "bake/supersample.h"
+#include "core/hash.h"
+#include "core/timer.h"
+
+namespace bb {
+
+nlohmann::json ErrorCheck::toJson() const {
+    return {{"rel_rmse", relRmse},     {"upper_bound", upperBound}, {"mean_square", meanSquare}, {"mean_square_error", meanSquareError},
+            {"texels", texels},        {"paths", paths},                  {"seconds", seconds},
+            {"conclusive", conclusive()}};
+}
+
+std::string ErrorCheck::summary() const {
+    char line[256];
+    std::snprintf(line, sizeof line, "error check: rel_rmse %.4g, at most %.4g (%s; %lld texels, %lld paths, %.1f s)",
+                  relRmse, upperBound, conclusive() ? "conclusive" : "inconclusive: more paths would tell",
+                  (long long)texels, (long long)paths, seconds);
+    return line;
+}
+
+Expected<ErrorCheck> checkError(const Scene& scene, const Layout& layout, const LightmapPages& maps,
+                                const ErrorCheckOptions& options) {
+    if (options.spp < 1 || options.pilotSpp < 2) return Status::error("the error check needs spp >= 1 and a pilot >= 2");
+    const auto t0 = Clock::now();
+    ReferenceOptions ro = options.reference;
+    ro.spp = 1;
+    auto reference = ReferenceBaker::create(scene, layout, ro);
+    if (!reference) return reference.status();
+    ReferenceBaker& r = **reference;
+
+    // the texels covered in both
+    const std::vector<TexelId> ids = r.coveredTexels();
+    std::vector<uint8_t> checked(ids.size(), 0);
+    int64_t count = 0;
+    for (size_t i = 0; i < ids.size(); ++i) {
+        const TexelId& t = ids[i];
+        checked[i] = t.page < maps.covered.size() && maps.covered[t.page][t.index] != 0;
+        count += checked[i];
+    }
+    if (count == 0) return Status::error("error check: no texel is covered in both the bake and the reference");
+
+    // pilot: each texel's sample variance sets its share of the budget
+    const uint64_t seed = hash(ro.seed, 0xE220C4EC4ull);
+    std::vector<uint32_t> spp(ids.size(), 0);
+    for (size_t i = 0; i < ids.size(); ++i) spp[i] = checked[i] ? uint32_t(options.pilotSpp) : 0u;
+    const std::vector<glm::dvec4> pilot = r.sampleTexels(hash(seed, 0), spp);
+    std::vector<double> weight(ids.size(), 0.0);
+    double weightSum = 0.0;
+    const double n0 = options.pilotSpp;
+    for (size_t i = 0; i < ids.size(); ++i) {
+        if (!checked[i]) continue;
+        weight[i] = std::pow(pilot[i].w / n0, 2.0 / 3.0);
+        weightSum += weight[i];
+    }
+    // a quarter of the budget evenly (a pilot can miss a texel's rare bright paths), the rest by weight
+    const double budget = double(options.spp) * double(count);
+    const double floorSpp = std::max(2.0, 0.25 * options.spp);
+    const double share = weightSum > 0.0 ? (budget - floorSpp * double(count)) / weightSum : 0.0;
+    for (size_t i = 0; i < ids.size(); ++i)
+        if (checked[i]) spp[i] = uint32_t(std::min(floorSpp + std::floor(share * weight[i]), double(1 << 24)));
+
+    // the two estimates as light maps: dilated into the padding and their seams stitched as the bake's were
+    // (both linear: the truth's image under them is what the bake's maps estimate)
+    std::array<LightmapPages, 2> estimates;
+    for (int e = 0; e < 2; ++e) {
+        const std::vector<glm::dvec4> sums = r.sampleTexels(hash(seed, uint64_t(e) + 1), spp);
+        const size_t perPage = size_t(layout.resolution) * layout.resolution;
+        std::vector<std::vector<glm::vec4>> pages(size_t(layout.pageCount), std::vector<glm::vec4>(perPage, glm::vec4(0.0f)));
+        for (size_t i = 0; i < ids.size(); ++i)
+            if (checked[i]) pages[ids[i].page][ids[i].index] = glm::vec4(glm::vec3(glm::dvec3(sums[i]) / double(spp[i])), 1.0f);
+        estimates[e].resolution = layout.resolution;
+        for (auto& page : pages) estimates[e].pages.push_back(dilatedImage(std::move(page), layout.resolution, layout.padding + 1));
+        estimates[e].covered = maps.covered;
+        if (options.stitchSeams) stitchSeams(estimates[e], findSeams(r.mesh(), layout.resolution));
+    }
+    std::vector<double> products;
+    products.reserve(size_t(count));
+    double referenceSum = 0.0;
+    for (size_t i = 0; i < ids.size(); ++i) {
+        if (!checked[i]) continue;
+        const auto at = [&](const LightmapPages& m) { return glm::dvec3(m.pages[ids[i].page].pixels[ids[i].index]); };
+        const glm::dvec3 baked = at(maps), a = at(estimates[0]), b = at(estimates[1]);
+        const glm::dvec3 ea = baked - a, eb = baked - b;
+        products.push_back((ea.x * eb.x + ea.y * eb.y + ea.z * eb.z) / 3.0);
+        referenceSum += (a.x + a.y + a.z + b.x + b.y + b.z) / 6.0;
+    }
+    const double n = double(count);
+    const double mean = referenceSum / n;
+    double sum = 0.0;
+    for (double p : products) sum += p;
+    const double productMean = sum / n;
+    double spread = 0.0;
+    for (double p : products) spread += (p - productMean) * (p - productMean);
+    const double productError = std::sqrt(spread / std::max(n - 1.0, 1.0) / n);
+
+    ErrorCheck out;
+    const double scale = mean != 0.0 ? 1.0 / (mean * mean) : 0.0;
+    out.meanSquare = productMean * scale;
+    out.meanSquareError = productError * scale;
+    out.relRmse = std::sqrt(std::max(0.0, out.meanSquare));
+    out.upperBound = std::sqrt(std::max(0.0, out.meanSquare + 2.0 * out.meanSquareError));
+    out.texels = count;
+    for (size_t i = 0; i < ids.size(); ++i) out.paths += int64_t(checked[i]) * (options.pilotSpp + 2 * int64_t(spp[i]));
+    out.seconds = secondsSince(t0);
+    return out;
+}
+
+}  // namespace bb

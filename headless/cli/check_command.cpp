@@ -1,0 +1,96 @@
+// `bundlebake check SCENE BAKE_DIR`: the error of a bake's light maps against
+// the truth, estimated by the CPU path tracer without a converged reference
+// (engine/reference/error_check.h). No GL.
+#include <cstdio>
+#include <fstream>
+
+#include "core/log.h"
+#include "headless/cli/options.h"
+#include "reference/error_check.h"
+#include "render/scene_renderer.h"
+
+namespace bb::cli {
+namespace {
+
+struct CheckArgs {
+    SceneArgs scene;
+    LayoutFlagsGiven given;
+    std::string bakeDir;
+    int spp = 256;
+    int threads = 0;
+    uint64_t seed = 1;
+    std::string sky, env;  // empty: as BAKE_DIR/stats.json's settings say
+    std::string seams;     // empty: as BAKE_DIR/stats.json's settings say (stitch if it does not)
+    bool json = false;
+};
+
+// What the flags left out as BAKE_DIR/stats.json "settings" (sky, env, seams) say.
+void settingsAsBaked(CheckArgs& args) {
+    std::ifstream in(args.bakeDir + "/stats.json");
+    const nlohmann::json stats = nlohmann::json::parse(in, nullptr, false);
+    const nlohmann::json s = stats.is_object() && stats.contains("settings") ? stats["settings"] : nlohmann::json::object();
+    const auto take = [&s](const char* key, std::string& value) {
+        if (value.empty() && s.contains(key) && s[key].is_string()) value = s[key].get<std::string>();
+    };
+    if (args.sky.empty() && args.env.empty()) {
+        take("sky", args.sky);
+        take("env", args.env);
+    }
+    take("seams", args.seams);
+}
+
+int runCheck(CheckArgs args) {
+    settingsAsBaked(args);
+    ErrorCheckOptions options;
+    auto sky = parseColor(args.sky.empty() ? "0,0,0" : args.sky, "--sky");
+    if (!sky) return fail(sky.error());
+    options.reference.sky = *sky;
+    if (Status s = loadEnvironment(args.env, options.reference.environment); !s) return fail(s.message());
+    options.reference.threads = args.threads;
+    options.reference.seed = args.seed;
+    options.spp = args.spp;
+    options.stitchSeams = args.seams != "off";
+    auto loaded = loadSceneWithBakeLayout(args.scene, args.given, args.bakeDir);
+    if (!loaded) return fail(loaded.error());
+    auto maps = readBakedLightmaps(args.bakeDir, loaded->layout);
+    if (!maps) return fail(maps.error());
+    auto check = checkError(loaded->scene, loaded->layout, *maps, options);
+    if (!check) return fail(check.error());
+    if (args.json) {
+        std::printf("%s\n", check->toJson().dump(2).c_str());
+        return 0;
+    }
+    std::printf("%s\n", check->summary().c_str());
+    return 0;
+}
+
+}  // namespace
+
+void addCheckCommand(CLI::App& app, std::function<int()>& action) {
+    auto a = std::make_shared<CheckArgs>();
+    CLI::App* cmd = app.add_subcommand(
+        "check", "Estimate a bake's error against the truth with the CPU path tracer, without a converged reference "
+                 "(relative RMSE, unbiased, with its standard error)");
+    addSceneOptions(*cmd, a->scene);
+    cmd->add_option("bake", a->bakeDir, "Directory written by `bundlebake bake` (its manifest.json gives the layout)")
+        ->required();
+    cmd->add_option("--spp", a->spp, "Mean paths per texel of each of the two estimates")
+        ->check(CLI::Range(1, 1 << 20))
+        ->capture_default_str();
+    cmd->add_option("--threads", a->threads, "Worker threads (0 = all cores)")
+        ->check(CLI::Range(0, 1024))
+        ->capture_default_str();
+    cmd->add_option("--seed", a->seed, "Random seed of the check's paths")->capture_default_str();
+    cmd->add_option("--sky", a->sky, "Uniform sky radiance r,g,b (default: the bake's, from its stats.json)");
+    cmd->add_option("--env", a->env, "Equirectangular environment map (default: the bake's)")
+        ->excludes(cmd->get_option("--sky"));
+    cmd->add_option("--seams", a->seams, "The bake's seams: stitch or off (default: the bake's)")
+        ->check(CLI::IsMember({"stitch", "off"}));
+    cmd->add_flag("--json", a->json, "Print the figures as JSON");
+    cmd->callback([a, cmd, &action] {
+        a->given = layoutFlagsGiven(*cmd);
+        action = [a] { return runCheck(*a); };
+    });
+}
+
+}  // namespace bb::cli
