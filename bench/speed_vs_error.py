@@ -33,7 +33,7 @@ against the converged reference at the origin); the furnace at rho 0.99
 (furnace_rho099). Their glTF files point at the original buffers (the
 lid's own is written next to it).
 
-Usage: bench/speed_vs_error.py [--bundlebake PATH] [--scenes a,b] [--quick]
+Usage: bench/speed_vs_error.py [--bundlebake PATH] [--scenes a,b] [--quick] [--tables-only] [--recheck]
 Run from anywhere; needs /usr/bin/python3 with python3-matplotlib.
 """
 import argparse
@@ -417,6 +417,11 @@ def converged_reference(exe, name, cfg):
     return path, note, stats_of(path)["seconds"]["total"]
 
 
+CSV_FIELDS = ["scene", "method", "param", "value", "seconds", "process_seconds", "rel_rmse", "rmse", "rel_mse",
+              "mean_ratio", "max_abs", "texels", "noise_estimate", "resolution_estimate", "check_estimate",
+              "check_bound", "check_seconds"]
+
+
 def sweep_point(exe, name, cfg, method, value, ref):
     scene = os.path.join(ROOT, cfg["path"])
     out = os.path.join(CACHE, "runs", name, "%s_%d" % (method, value))
@@ -439,9 +444,45 @@ def sweep_point(exe, name, cfg, method, value, ref):
            # resolution probe's bias (noise.resolution), where the bake was probed
            "noise_estimate": s.get("noise", {}).get("relative", "") if method == "bundlebake" else "",
            "resolution_estimate": s.get("noise", {}).get("resolution", "") if method == "bundlebake" else ""}
+    if method == "bundlebake":
+        row.update(check_columns(s.get("noise", {}).get("check")))
     log("[%s] %-10s %-10s %6d: %7.3f s (process %6.2f s) rel_rmse %.4f mean_ratio %.4f" %
         (name, method, row["param"], value, seconds, wall, c["rel_rmse"], c["mean_ratio"]))
     return row
+
+
+def check_columns(check):
+    """The path-traced error check's figures (stats.json noise.check, or `bundlebake check --json`): its estimate
+    where conclusive, its upper bound, its seconds (outside seconds.total: a measurement, not the bake)."""
+    if not check:
+        return {"check_estimate": "", "check_bound": "", "check_seconds": ""}
+    return {"check_estimate": check["rel_rmse"] if check["conclusive"] else "", "check_bound": check["upper_bound"],
+            "check_seconds": check["seconds"]}
+
+
+def recheck(exe, name, cfg):
+    """The check columns of a scene's kept results.csv again, from `bundlebake check` on the kept bakes in
+    bench/cache/runs (at the paths per texel a bake's --error-check auto takes: directions / 8, 16 to 512)."""
+    path = os.path.join(RESULTS, name, "results.csv")
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    for r in rows:
+        if r["method"] != "bundlebake":
+            continue
+        bake = os.path.join(CACHE, "runs", name, "bundlebake_%s" % r["value"])
+        spp = max(16, min(512, int(r["value"]) // 8))
+        out, _ = run([exe, "-q", "check", os.path.join(ROOT, cfg["path"]), bake, "--spp", str(spp), "--json"])
+        r.update(check_columns(json.loads(out)))
+        log("[%s] check %s directions: %s" % (name, r["value"], out.replace("\n", " ")))
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=CSV_FIELDS)
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: r.get(k, "") for k in CSV_FIELDS})
+    head, _ = run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"])
+    with open(os.path.join(RESULTS, name, "rechecked.txt"), "w") as f:
+        f.write("The path-traced check's columns: `--recheck` on %s on %s, on the bakes kept from the sweep.\n" %
+                (datetime.datetime.now().strftime("%Y-%m-%d %H:%M"), head.strip()))
 
 
 def interp_loglog(points, t):
@@ -457,13 +498,11 @@ def interp_loglog(points, t):
 def write_outputs(name, cfg, rows, ref_note, ref_seconds, measured=None):
     outdir = os.path.join(RESULTS, name)
     os.makedirs(outdir, exist_ok=True)
-    fields = ["scene", "method", "param", "value", "seconds", "process_seconds", "rel_rmse", "rmse", "rel_mse",
-              "mean_ratio", "max_abs", "texels", "noise_estimate", "resolution_estimate"]
     with open(os.path.join(outdir, "results.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=fields)
+        w = csv.DictWriter(f, fieldnames=CSV_FIELDS)
         w.writeheader()
         for r in rows:
-            w.writerow(r)
+            w.writerow({k: r.get(k, "") for k in CSV_FIELDS})
 
     gpu = [r for r in rows if r["method"] == "bundlebake"]
     cpu = [r for r in rows if r["method"] == "reference"]
@@ -504,14 +543,20 @@ def write_outputs(name, cfg, rows, ref_note, ref_seconds, measured=None):
              "bundlebake: defaults (bundle resolution from the texel density, 512M budget, stochastic rounding, "
              "automatic history power, supersample auto), seed %s. Reference sweep: 2 threads, seed %s, flags `%s`." %
              (SWEEP_SEED, SWEEP_SEED, " ".join(cfg["reference_flags"]) or "(defaults: emitter sampling on)"), ""]
+    rechecked = os.path.join(outdir, "rechecked.txt")
+    if measured is None and os.path.exists(rechecked):
+        os.remove(rechecked)  # a new sweep: its checks are its own
+    if os.path.exists(rechecked):
+        with open(rechecked) as f:
+            lines += [f.read().strip(), ""]
     if noise is not None:
         lines.append("Estimated noise of the converged reference itself: rel_rmse %.4f (a floor under every error "
                      "below)." % noise)
         lines.append("")
     lines += ["| baker | setting | time s | process s | rel_rmse | less the reference's noise | own noise estimate | "
-              "estimate / error | resolution probe | both / error | mean_ratio | max_abs | "
-              "reference's rel_rmse at equal time | ratio | ratio less the reference's noise |",
-              "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+              "estimate / error | resolution probe | path-traced check | check s | error estimate / error | "
+              "mean_ratio | max_abs | reference's rel_rmse at equal time | ratio | ratio less the reference's noise |",
+              "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in gpu:
         at = interp_loglog(cpu_curve, r["seconds"])
         # the bake's error against the truth: the converged reference's own noise is independent of it
@@ -519,20 +564,28 @@ def write_outputs(name, cfg, rows, ref_note, ref_seconds, measured=None):
         estimate = "%.4f" % r["noise_estimate"] if r["noise_estimate"] != "" else "-"
         versus = "%.2f" % (r["noise_estimate"] / own) if r["noise_estimate"] != "" and own > 0 else "-"
         # with the resolution probe's bias (noise.error_estimate), where the bake was probed
-        resolution, with_resolution = "-", "-"
+        resolution, error_estimate = "-", r["noise_estimate"]
         if r.get("resolution_estimate", "") != "" and r["noise_estimate"] != "":
             resolution = "%.4f" % r["resolution_estimate"]
-            if own > 0:
-                with_resolution = "%.2f" % (math.hypot(r["noise_estimate"], r["resolution_estimate"]) / own)
+            error_estimate = math.hypot(r["noise_estimate"], r["resolution_estimate"])
+        # the path-traced check where it was conclusive (noise.error_estimate then), else its upper bound
+        check, check_seconds = "-", "-"
+        if r.get("check_estimate", "") != "":
+            check, error_estimate = "%.4f" % r["check_estimate"], r["check_estimate"]
+        elif r.get("check_bound", "") != "":
+            check = "< %.4f" % r["check_bound"]
+        if r.get("check_seconds", "") != "":
+            check_seconds = "%.1f" % r["check_seconds"]
+        with_resolution = "%.2f" % (error_estimate / own) if error_estimate != "" and own > 0 else "-"
         # both errors against the truth: the sweep's runs are as independent of the
         # converged reference's noise as the bake is
         at_own = math.sqrt(max(at ** 2 - (noise or 0.0) ** 2, 0.0)) if at else 0.0
-        lines.append("| bundlebake | %d directions | %.3f | %.2f | %.4f | %.4f | %s | %s | %s | %s | %.4f | %.4g | %s | %s | %s |" %
+        lines.append("| bundlebake | %d directions | %.3f | %.2f | %.4f | %.4f | %s | %s | %s | %s | %s | %s | %.4f | %.4g | %s | %s | %s |" %
                      (r["value"], r["seconds"], r["process_seconds"], r["rel_rmse"], own, estimate, versus,
-                      resolution, with_resolution, r["mean_ratio"], r["max_abs"], "%.4f" % at if at else "out of range",
+                      resolution, check, check_seconds, with_resolution, r["mean_ratio"], r["max_abs"], "%.4f" % at if at else "out of range",
                       "%.2f" % (r["rel_rmse"] / at) if at else "-", "%.2f" % (own / at_own) if at_own > 0 else "-"))
     for r in cpu:
-        lines.append("| reference | %d spp | %.3f | %.2f | %.4f | | | | | | %.4f | %.4g | | | |" %
+        lines.append("| reference | %d spp | %.3f | %.2f | %.4f | | | | | | | | %.4f | %.4g | | | |" %
                      (r["value"], r["seconds"], r["process_seconds"], r["rel_rmse"], r["mean_ratio"], r["max_abs"]))
     lines.append("")
     lines.append("ratio = bundlebake's error / the reference baker's error at the same time (log-log interpolated); "
@@ -543,8 +596,11 @@ def write_outputs(name, cfg, rows, ref_note, ref_seconds, measured=None):
                  "2026-12-05 09:40 hold the noise only); it falls short of rel_rmse by the other biases. Resolution "
                  "probe: noise.resolution, the bias of reading light a texel at a time, from the detail the baked texels "
                  "hold (since 2026-12-06; texel by texel from 2026-12-06 06:00, before which it was summed at p = 1 "
-                 "and read high where charts are about a texel wide), and both / error: noise.error_estimate, the two "
-                 "added in quadrature, over the error. Less "
+                 "and read high where charts are about a texel wide), the path-traced check: noise.check, the mean of "
+                 "(b - A)(b - B) over the texels for two independent path-traced estimates A, B of each (`bundlebake "
+                 "check`, bias and noise alike), where conclusive (3 standard errors above 0; else its upper bound, "
+                 "'< x'), and its seconds (after the bake, outside its time). Error estimate / error: noise.error_estimate "
+                 "(the check where conclusive, else the noise and the probe added in quadrature) over the error. Less "
                  "the reference's noise: sqrt(rel_rmse^2 - its noise^2), the bake's error against the truth (the two "
                  "are independent); estimate / error is the estimate over it (the goal: within 1.5x either way).")
     lines.append("")
@@ -565,6 +621,8 @@ def rewrite_tables(name, cfg):
             r[k] = float(r[k])
         r["noise_estimate"] = float(r["noise_estimate"]) if r["noise_estimate"] else ""
         r["resolution_estimate"] = float(r["resolution_estimate"]) if r.get("resolution_estimate") else ""
+        for k in ("check_estimate", "check_bound", "check_seconds"):
+            r[k] = float(r[k]) if r.get(k) else ""
     with open(os.path.join(outdir, "table.md")) as f:
         head = f.read()
     when = re.search(r"Measured ([\d-]+ [\d:]+)\.", head)
@@ -585,6 +643,9 @@ def main():
     ap.add_argument("--scenes", default=",".join(SCENES), help="comma-separated: " + ", ".join(SCENES))
     ap.add_argument("--tables-only", action="store_true",
                     help="rewrite the tables, plots and summary from the kept results.csv, running nothing")
+    ap.add_argument("--recheck", action="store_true",
+                    help="run `bundlebake check` on the kept bakes (bench/cache/runs) into the kept results.csv, then "
+                         "rewrite the tables as --tables-only")
     ap.add_argument("--quick", action="store_true", help="first three points of each sweep, 1/8 of the converged spp")
     args = ap.parse_args()
     exe = args.bundlebake
@@ -605,7 +666,9 @@ def main():
             cfg["spp"] = cfg["spp"][:3]
             if "converged_spp" in cfg:
                 cfg["converged_spp"] //= 8
-        if args.tables_only:
+        if args.recheck:
+            recheck(exe, name, cfg)
+        if args.tables_only or args.recheck:
             sections[name] = rewrite_tables(name, cfg)
             continue
         if "make" in cfg:
@@ -626,7 +689,8 @@ def main():
               "GL: Mesa llvmpipe (CPU). Whole run: %.0f s." %
               (datetime.datetime.now().strftime("%Y-%m-%d %H:%M"), platform.node(), os.cpu_count(),
                platform.processor() or platform.machine(), load[0], load[1], load[2], time.monotonic() - t0),
-              ("Tables rewritten from the kept results (--tables-only): %s." if args.tables_only else
+              ("Path-traced checks of the kept bakes run again, tables rewritten (--recheck): %s." if args.recheck else
+               "Tables rewritten from the kept results (--tables-only): %s." if args.tables_only else
                "This run: %s; the other scenes' tables are from their last runs.") % ", ".join(run), ""]
     os.makedirs(RESULTS, exist_ok=True)
     with open(os.path.join(RESULTS, "summary.md"), "w") as f:

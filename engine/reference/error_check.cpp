@@ -22,7 +22,7 @@ nlohmann::json ErrorCheck::toJson() const {
 
 std::string ErrorCheck::summary() const {
     char line[256];
-    std::snprintf(line, sizeof line, "error check: rel_rmse %.4g, at most %.4g (%s; %lld texels, %lld paths, %.1f s)",
+    std::snprintf(line, sizeof line, "path-traced check: rel_rmse %.4g, at most %.4g (%s; %lld texels, %lld paths, %.1f s)",
                   relRmse, upperBound, conclusive() ? "conclusive" : "inconclusive: more paths would tell",
                   (long long)texels, (long long)paths, seconds);
     return line;

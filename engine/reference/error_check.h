@@ -62,7 +62,7 @@ struct ErrorCheck {
     // above 0 (relRmse then within about +-17 %, one standard error)
     bool conclusive() const { return meanSquare > 0 && meanSquare >= 3.0 * meanSquareError; }
     nlohmann::json toJson() const;
-    std::string summary() const;  // one line: the estimate, its bound, the work
+    std::string summary() const;  // one line: the estimate, its bound, the work (no "error": it is no failure)
 };
 
 // Checks `maps` (the bake of `scene` laid out as `layout`) texel by texel.
