@@ -462,7 +462,7 @@ def check_columns(check):
 
 def recheck(exe, name, cfg):
     """The check columns of a scene's kept results.csv again, from `bundlebake check` on the kept bakes in
-    bench/cache/runs (at the paths per texel a bake's --error-check auto takes: directions / 8, 16 to 512)."""
+    bench/cache/runs (`--spp auto`: the paths per texel a bake's --error-check auto takes)."""
     path = os.path.join(RESULTS, name, "results.csv")
     with open(path, newline="") as f:
         rows = list(csv.DictReader(f))
@@ -470,8 +470,7 @@ def recheck(exe, name, cfg):
         if r["method"] != "bundlebake":
             continue
         bake = os.path.join(CACHE, "runs", name, "bundlebake_%s" % r["value"])
-        spp = max(16, min(512, int(r["value"]) // 8))
-        out, _ = run([exe, "-q", "check", os.path.join(ROOT, cfg["path"]), bake, "--spp", str(spp), "--json"])
+        out, _ = run([exe, "-q", "check", os.path.join(ROOT, cfg["path"]), bake, "--spp", "auto", "--json"])
         r.update(check_columns(json.loads(out)))
         log("[%s] check %s directions: %s" % (name, r["value"], out.replace("\n", " ")))
     with open(path, "w", newline="") as f:

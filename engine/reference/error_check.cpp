@@ -16,7 +16,7 @@ namespace bb {
 
 nlohmann::json ErrorCheck::toJson() const {
     return {{"rel_rmse", relRmse},     {"upper_bound", upperBound}, {"mean_square", meanSquare}, {"mean_square_error", meanSquareError},
-            {"texels", texels},        {"paths", paths},                  {"seconds", seconds},
+            {"texels", texels},        {"spp", spp}, {"paths", paths},                  {"seconds", seconds},
             {"conclusive", conclusive()}};
 }
 
@@ -26,6 +26,12 @@ std::string ErrorCheck::summary() const {
                   relRmse, upperBound, conclusive() ? "conclusive" : "inconclusive: more paths would tell",
                   (long long)texels, (long long)paths, seconds);
     return line;
+}
+
+void setAutoBudget(ErrorCheckOptions& options, int directions, double bakeEstimate) {
+    options.spp = std::clamp(directions / 4, 16, 1024);
+    options.fallbackSpp = std::clamp(directions / 16, 16, 256);
+    options.expectedError = bakeEstimate;
 }
 
 Expected<ErrorCheck> checkError(const Scene& scene, const Layout& layout, const LightmapPages& maps,
@@ -63,11 +69,35 @@ Expected<ErrorCheck> checkError(const Scene& scene, const Layout& layout, const 
         weightSum += weight[i];
     }
     // a quarter of the budget evenly (a pilot can miss a texel's rare bright paths), the rest by weight
-    const double budget = double(options.spp) * double(count);
-    const double floorSpp = std::max(2.0, 0.25 * options.spp);
-    const double share = weightSum > 0.0 ? (budget - floorSpp * double(count)) / weightSum : 0.0;
-    for (size_t i = 0; i < ids.size(); ++i)
-        if (checked[i]) spp[i] = uint32_t(std::min(floorSpp + std::floor(share * weight[i]), double(1 << 24)));
+    const auto allocate = [&](int meanSpp) {
+        const double budget = double(meanSpp) * double(count);
+        const double floorSpp = std::max(2.0, 0.25 * meanSpp);
+        const double share = weightSum > 0.0 ? (budget - floorSpp * double(count)) / weightSum : 0.0;
+        for (size_t i = 0; i < ids.size(); ++i)
+            if (checked[i]) spp[i] = uint32_t(std::min(floorSpp + std::floor(share * weight[i]), double(1 << 24)));
+    };
+    int meanSpp = options.spp;
+    allocate(meanSpp);
+    if (options.fallbackSpp > 0 && options.expectedError > 0.0) {
+        // the standard error of the mean product at this budget, from the pilot's sample variances (the
+        // reference's noise alone): past (2 expectedError)^2 / 3 not even twice the expected error would
+        // be conclusive, and the fallback's bound is worth as much
+        double squares = 0.0, sum = 0.0;
+        for (size_t i = 0; i < ids.size(); ++i) {
+            if (!checked[i]) continue;
+            const double texelMean = (pilot[i].x + pilot[i].y + pilot[i].z) / (3.0 * n0);
+            const double s = std::max(0.0, (pilot[i].w - n0 * texelMean * texelMean) / (n0 - 1.0)) / double(spp[i]);
+            squares += s * s;
+            sum += texelMean;
+        }
+        const double mapMean = sum / double(count);
+        const double predicted = mapMean > 0.0 ? std::sqrt(squares) / double(count) / (mapMean * mapMean) : 0.0;
+        const double resolvable = 4.0 * options.expectedError * options.expectedError / 3.0;
+        if (predicted > resolvable) {
+            meanSpp = std::min(options.fallbackSpp, options.spp);
+            allocate(meanSpp);
+        }
+    }
 
     // the two estimates as light maps: dilated into the padding and their seams stitched as the bake's were
     // (both linear: the truth's image under them is what the bake's maps estimate)
@@ -110,6 +140,7 @@ Expected<ErrorCheck> checkError(const Scene& scene, const Layout& layout, const 
     out.relRmse = std::sqrt(std::max(0.0, out.meanSquare));
     out.upperBound = std::sqrt(std::max(0.0, out.meanSquare + 2.0 * out.meanSquareError));
     out.texels = count;
+    out.spp = meanSpp;
     for (size_t i = 0; i < ids.size(); ++i) out.paths += int64_t(checked[i]) * (options.pilotSpp + 2 * int64_t(spp[i]));
     out.seconds = secondsSince(t0);
     return out;

@@ -46,6 +46,11 @@ namespace bb {
 struct ErrorCheckOptions {
     ReferenceOptions reference;  // sky, environment, threads, seed (spp, passSpp unused)
     int spp = 256;               // mean paths per texel per estimate (two estimates, plus the pilot)
+    // Where the pilot's variances say that spp would not resolve even twice expectedError (> 0: the
+    // error the bake expects, e.g. its noise estimate), fallbackSpp (> 0) instead: small maps spread
+    // the reference's noise over few texels, and there the check can only bound the error cheaply.
+    int fallbackSpp = 0;
+    double expectedError = 0;
     int pilotSpp = 16;           // paths per texel of the pilot
     bool stitchSeams = true;     // the bake's seams were stitched (bake/seam_stitch.h): stitch the estimates'
 };
@@ -56,6 +61,7 @@ struct ErrorCheck {
     double meanSquareError = 0;  // its standard error (from the spread of the texels' products)
     double upperBound = 0;       // sqrt(meanSquare + 2 meanSquareError): relRmse's upper bound at about 98 %
     int64_t texels = 0;        // covered in both the maps and the reference
+    int spp = 0;               // mean paths per texel per estimate, as traced
     int64_t paths = 0;         // traced, pilot included
     double seconds = 0;        // BVH, coverage and tracing
     // relRmse is an estimate worth reporting: meanSquare at least 3 standard errors
@@ -64,6 +70,12 @@ struct ErrorCheck {
     nlohmann::json toJson() const;
     std::string summary() const;  // one line: the estimate, its bound, the work (no "error": it is no failure)
 };
+
+// The budget `bake --error-check auto` and `check --spp auto` take after a
+// bake of `directions` whose own estimate (noise and resolution probe) was
+// `bakeEstimate`: directions / 4 paths per texel and estimate (16 to 1024),
+// directions / 16 (16 to 256) where that would not resolve twice the estimate.
+void setAutoBudget(ErrorCheckOptions& options, int directions, double bakeEstimate);
 
 // Checks `maps` (the bake of `scene` laid out as `layout`) texel by texel.
 // Errors: the reference's (bad options, a scene without triangles), no texel

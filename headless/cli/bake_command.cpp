@@ -97,14 +97,9 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
     cmd.add_option("--error-check", a.errorCheck,
                    "After the bake, estimate its error against the truth with the CPU path tracer: two independent "
                    "estimates of every texel of N paths each on average, where the reference is noisiest most "
-                   "(stats.json noise.check; unbiased, bias and noise alike); auto = directions / 8 (16 to 512), off")
-        ->check([](const std::string& v) -> std::string {
-            if (v == "auto" || v == "off") return {};
-            char* end = nullptr;
-            const long n = std::strtol(v.c_str(), &end, 10);
-            return end != v.c_str() && *end == 0 && n >= 1 && n <= (1 << 20) ? std::string{}
-                                                                             : "must be auto, off or 1 to 1048576";
-        })
+                   "(stats.json noise.check; unbiased, bias and noise alike); auto = directions / 4 (16 to 1024), or "
+                   "directions / 16 where that could not resolve twice the bake's own estimate; off")
+        ->check(countOr({"auto", "off"}, 1 << 20))
         ->capture_default_str();
     addSeamsOption(cmd, a.seams);
     cmd.add_option("--checkpoint-every", a.checkpointEvery,
@@ -272,12 +267,13 @@ int runBake(const BakeArgs& args) {
         check.reference.environment = options.environment;
         check.reference.threads = 0;
         check.stitchSeams = args.seams == "stitch";
-        check.spp = args.errorCheck == "auto" ? std::clamp((*baker)->progress().directionsDone / 8, 16, 512)
-                                              : std::atoi(args.errorCheck.c_str());
+        if (args.errorCheck == "auto")
+            setAutoBudget(check, (*baker)->progress().directionsDone, (*baker)->stats().errorEstimate());
+        else
+            check.spp = std::atoi(args.errorCheck.c_str());
         auto result = checkError(loaded->scene, loaded->layout, maps, check);
         if (!result) return fail(result.error());
         stats["noise"]["check"] = result->toJson();
-        stats["noise"]["check"]["spp"] = check.spp;
         if (result->conclusive()) stats["noise"]["error_estimate"] = result->relRmse;
         logInfo(result->summary());
     }

@@ -1,7 +1,9 @@
 // `bundlebake check SCENE BAKE_DIR`: the error of a bake's light maps against
 // the truth, estimated by the CPU path tracer without a converged reference
 // (engine/reference/error_check.h). No GL.
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 
 #include "core/log.h"
@@ -16,7 +18,7 @@ struct CheckArgs {
     SceneArgs scene;
     LayoutFlagsGiven given;
     std::string bakeDir;
-    int spp = 256;
+    std::string spp = "auto";
     int threads = 0;
     uint64_t seed = 1;
     std::string sky, env;  // empty: as BAKE_DIR/stats.json's settings say
@@ -24,10 +26,14 @@ struct CheckArgs {
     bool json = false;
 };
 
+nlohmann::json readStats(const std::string& bakeDir) {
+    std::ifstream in(bakeDir + "/stats.json");
+    return nlohmann::json::parse(in, nullptr, false);
+}
+
 // What the flags left out as BAKE_DIR/stats.json "settings" (sky, env, seams) say.
 void settingsAsBaked(CheckArgs& args) {
-    std::ifstream in(args.bakeDir + "/stats.json");
-    const nlohmann::json stats = nlohmann::json::parse(in, nullptr, false);
+    const nlohmann::json stats = readStats(args.bakeDir);
     const nlohmann::json s = stats.is_object() && stats.contains("settings") ? stats["settings"] : nlohmann::json::object();
     const auto take = [&s](const char* key, std::string& value) {
         if (value.empty() && s.contains(key) && s[key].is_string()) value = s[key].get<std::string>();
@@ -48,7 +54,17 @@ int runCheck(CheckArgs args) {
     if (Status s = loadEnvironment(args.env, options.reference.environment); !s) return fail(s.message());
     options.reference.threads = args.threads;
     options.reference.seed = args.seed;
-    options.spp = args.spp;
+    if (args.spp == "auto") {  // as the bake's own check: from its directions and its estimate
+        const nlohmann::json stats = readStats(args.bakeDir);
+        const nlohmann::json* noise = stats.is_object() && stats.contains("noise") ? &stats["noise"] : nullptr;
+        if (!noise || !stats.contains("directions") || !noise->contains("relative"))
+            return fail(args.bakeDir + "/stats.json: no directions and noise estimate to take the budget from; give --spp N");
+        // the bake's own estimate: the noise and the resolution probe, not a check's
+        const double own = std::hypot((*noise)["relative"].get<double>(), noise->value("resolution", 0.0));
+        setAutoBudget(options, stats["directions"]["done"].get<int>(), own);
+    } else {
+        options.spp = std::atoi(args.spp.c_str());
+    }
     options.stitchSeams = args.seams != "off";
     auto loaded = loadSceneWithBakeLayout(args.scene, args.given, args.bakeDir);
     if (!loaded) return fail(loaded.error());
@@ -74,8 +90,10 @@ void addCheckCommand(CLI::App& app, std::function<int()>& action) {
     addSceneOptions(*cmd, a->scene);
     cmd->add_option("bake", a->bakeDir, "Directory written by `bundlebake bake` (its manifest.json gives the layout)")
         ->required();
-    cmd->add_option("--spp", a->spp, "Mean paths per texel of each of the two estimates")
-        ->check(CLI::Range(1, 1 << 20))
+    cmd->add_option("--spp", a->spp,
+                    "Mean paths per texel of each of the two estimates, or auto: as `bake --error-check auto` takes "
+                    "them from the bake's directions and its own error estimate (its stats.json)")
+        ->check(countOr({"auto"}, 1 << 20))
         ->capture_default_str();
     cmd->add_option("--threads", a->threads, "Worker threads (0 = all cores)")
         ->check(CLI::Range(0, 1024))

@@ -1,6 +1,8 @@
 #include "headless/cli/options.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <sstream>
 
@@ -273,5 +275,19 @@ void addHistoryOptions(CLI::App& cmd, float& power, int& plateau) {
 }
 
 int supersampleValue(const std::string& supersample) { return supersample == "auto" ? 0 : std::stoi(supersample); }
+
+CLI::Validator countOr(std::vector<std::string> words, long max) {
+    std::string names;
+    for (const std::string& w : words) names += w + ", ";
+    const std::string description = "must be " + names + "or 1 to " + std::to_string(max);
+    return CLI::Validator(
+        [words, max, description](std::string& v) -> std::string {
+            if (std::find(words.begin(), words.end(), v) != words.end()) return {};
+            char* end = nullptr;
+            const long n = std::strtol(v.c_str(), &end, 10);
+            return end != v.c_str() && *end == 0 && n >= 1 && n <= max ? std::string{} : description;
+        },
+        "");
+}
 
 }  // namespace bb::cli

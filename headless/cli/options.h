@@ -102,6 +102,9 @@ LayoutFlagsGiven layoutFlagsGiven(const CLI::App& cmd);
 Expected<LoadedScene> loadSceneWithBakeLayout(const SceneArgs& args, const LayoutFlagsGiven& given,
                                               const std::string& bakeDir);
 
+// An option's check: a whole number in [1, max], or one of `words` ("auto", "off").
+CLI::Validator countOr(std::vector<std::string> words, long max);
+
 // --uv-layout's names.
 UvLayout parseUvLayout(const std::string& name);
 const char* uvLayoutName(UvLayout mode);

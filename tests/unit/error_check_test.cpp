@@ -42,8 +42,7 @@ Furnace furnace() {
     return f;
 }
 
-ErrorCheck check(const Furnace& f, const LightmapPages& maps) {
-    ErrorCheckOptions o;
+ErrorCheck check(const Furnace& f, const LightmapPages& maps, ErrorCheckOptions o = {}) {
     o.spp = 256;
     o.reference.threads = 2;
     o.stitchSeams = false;  // the furnace's maps are not stitched here
@@ -90,6 +89,19 @@ TEST(ErrorCheck, ExactMapsReadZeroAndInconclusive) {
     EXPECT_NEAR(c.meanSquare, 0.0, 4 * c.meanSquareError);
     EXPECT_FALSE(c.conclusive());
     EXPECT_GE(c.upperBound, c.relRmse);
+}
+
+// The budget: where the pilot says 256 paths could not resolve twice the
+// expected error (0.01 %: far under the reference's noise over ~800 texels),
+// the fallback's; where they could (5 %), all of them.
+TEST(ErrorCheck, FallsBackWhereTheExpectedErrorCannotBeResolved) {
+    Furnace f = furnace();
+    ErrorCheckOptions o;
+    o.fallbackSpp = 16;
+    o.expectedError = 1e-4;
+    EXPECT_EQ(check(f, f.truth, o).spp, 16);
+    o.expectedError = 0.05;
+    EXPECT_EQ(check(f, f.truth, o).spp, 256);
 }
 
 }  // namespace
