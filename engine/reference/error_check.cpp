@@ -28,6 +28,10 @@ std::string ErrorCheck::summary() const {
     return line;
 }
 
+namespace {
+constexpr double kNominalRays = 6.0;  // rays a path of the bench's scenes takes at most (1.7-5.7, shadow rays included)
+}  // namespace
+
 void setAutoBudget(ErrorCheckOptions& options, int directions, double bakeEstimate) {
     options.spp = std::clamp(directions / 4, 16, 1024);
     options.fallbackSpp = std::clamp(directions / 16, 16, 256);
@@ -76,7 +80,12 @@ Expected<ErrorCheck> checkError(const Scene& scene, const Layout& layout, const 
         for (size_t i = 0; i < ids.size(); ++i)
             if (checked[i]) spp[i] = uint32_t(std::min(floorSpp + std::floor(share * weight[i]), double(1 << 24)));
     };
-    int meanSpp = options.spp;
+    // the budget is in rays: paths longer than kNominalRays (a high albedo's) get proportionally fewer
+    const ReferenceStats& traced = r.stats();
+    const double raysPerPath = traced.paths > 0 ? double(traced.rays + traced.shadowRays) / double(traced.paths) : 1.0;
+    const double rayShare = std::min(1.0, kNominalRays / std::max(raysPerPath, 1.0));
+    const auto scaled = [&](int paths) { return std::max(2, int(std::lround(paths * rayShare))); };
+    int meanSpp = scaled(options.spp);
     allocate(meanSpp);
     if (options.fallbackSpp > 0 && options.expectedError > 0.0) {
         // the standard error of the mean product at this budget, from the pilot's sample variances (the
@@ -94,7 +103,7 @@ Expected<ErrorCheck> checkError(const Scene& scene, const Layout& layout, const 
         const double predicted = mapMean > 0.0 ? std::sqrt(squares) / double(count) / (mapMean * mapMean) : 0.0;
         const double resolvable = 4.0 * options.expectedError * options.expectedError / 3.0;
         if (predicted > resolvable) {
-            meanSpp = std::min(options.fallbackSpp, options.spp);
+            meanSpp = scaled(std::min(options.fallbackSpp, options.spp));
             allocate(meanSpp);
         }
     }

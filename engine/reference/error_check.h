@@ -45,7 +45,10 @@ namespace bb {
 
 struct ErrorCheckOptions {
     ReferenceOptions reference;  // sky, environment, threads, seed (spp, passSpp unused)
-    int spp = 256;               // mean paths per texel per estimate (two estimates, plus the pilot)
+    // Mean paths per texel per estimate (two estimates, plus the pilot) where a path takes 6 rays or
+    // fewer (segments and shadow rays; 1.7-5.7 on the bench's scenes); where the pilot's paths take
+    // more (a high albedo: the rho 0.99 furnace's run ~100 bounces), proportionally fewer.
+    int spp = 256;
     // Where the pilot's variances say that spp would not resolve even twice expectedError (> 0: the
     // error the bake expects, e.g. its noise estimate), fallbackSpp (> 0) instead: small maps spread
     // the reference's noise over few texels, and there the check can only bound the error cheaply.
