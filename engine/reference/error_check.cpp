@@ -59,7 +59,7 @@ Expected<ErrorCheck> checkError(const Scene& scene, const Layout& layout, const 
     }
     if (count == 0) return Status::error("error check: no texel is covered in both the bake and the reference");
 
-    // pilot: each texel's sample variance sets its share of the budget
+    // pilot: each texel's samples' second moment sets its share of the budget
     const uint64_t seed = hash(ro.seed, 0xE220C4EC4ull);
     std::vector<uint32_t> spp(ids.size(), 0);
     for (size_t i = 0; i < ids.size(); ++i) spp[i] = checked[i] ? uint32_t(options.pilotSpp) : 0u;
