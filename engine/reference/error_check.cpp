@@ -16,7 +16,7 @@ namespace bb {
 
 nlohmann::json ErrorCheck::toJson() const {
     return {{"rel_rmse", relRmse},     {"upper_bound", upperBound}, {"mean_square", meanSquare}, {"mean_square_error", meanSquareError},
-            {"texels", texels},        {"spp", spp}, {"paths", paths},                  {"seconds", seconds},
+            {"texels", texels}, {"covered_texels", coveredTexels}, {"spp", spp}, {"paths", paths},                  {"seconds", seconds},
             {"conclusive", conclusive()}};
 }
 
@@ -58,6 +58,18 @@ Expected<ErrorCheck> checkError(const Scene& scene, const Layout& layout, const 
         count += checked[i];
     }
     if (count == 0) return Status::error("error check: no texel is covered in both the bake and the reference");
+    // a large map: a uniform random subset of its texels (by a hash of each, so the same for any run)
+    const int64_t covered = count;
+    if (options.maxTexels > 0 && count > options.maxTexels) {
+        const double keep = double(options.maxTexels) / double(count);
+        count = 0;
+        for (size_t i = 0; i < ids.size(); ++i) {
+            const uint64_t h = hash(ro.seed, 0x5B5E7ull, uint64_t(ids[i].page) << 32 | ids[i].index);
+            checked[i] = checked[i] && double(h >> 11) * 0x1p-53 < keep;
+            count += checked[i];
+        }
+        if (count == 0) return Status::error("error check: the subset of texels is empty");
+    }
 
     // pilot: each texel's samples' second moment sets its share of the budget
     const uint64_t seed = hash(ro.seed, 0xE220C4EC4ull);
@@ -109,12 +121,18 @@ Expected<ErrorCheck> checkError(const Scene& scene, const Layout& layout, const 
     }
 
     // the two estimates as light maps: dilated into the padding and their seams stitched as the bake's were
-    // (both linear: the truth's image under them is what the bake's maps estimate)
+    // (both linear: the truth's image under them is what the bake's maps estimate). Covered texels not
+    // checked (a subset; the few the reference does not cover) hold the bake's values, so that a seam
+    // through them is stitched against what the bake has there.
     std::array<LightmapPages, 2> estimates;
+    const size_t perPage = size_t(layout.resolution) * layout.resolution;
+    std::vector<std::vector<glm::vec4>> baked(size_t(layout.pageCount), std::vector<glm::vec4>(perPage, glm::vec4(0.0f)));
+    for (size_t p = 0; p < baked.size() && p < maps.pages.size(); ++p)
+        for (size_t t = 0; t < perPage; ++t)
+            if (maps.covered[p][t]) baked[p][t] = glm::vec4(maps.pages[p].pixels[t], 1.0f);
     for (int e = 0; e < 2; ++e) {
         const std::vector<glm::dvec4> sums = r.sampleTexels(hash(seed, uint64_t(e) + 1), spp);
-        const size_t perPage = size_t(layout.resolution) * layout.resolution;
-        std::vector<std::vector<glm::vec4>> pages(size_t(layout.pageCount), std::vector<glm::vec4>(perPage, glm::vec4(0.0f)));
+        std::vector<std::vector<glm::vec4>> pages = baked;
         for (size_t i = 0; i < ids.size(); ++i)
             if (checked[i]) pages[ids[i].page][ids[i].index] = glm::vec4(glm::vec3(glm::dvec3(sums[i]) / double(spp[i])), 1.0f);
         estimates[e].resolution = layout.resolution;
@@ -149,6 +167,7 @@ Expected<ErrorCheck> checkError(const Scene& scene, const Layout& layout, const 
     out.relRmse = std::sqrt(std::max(0.0, out.meanSquare));
     out.upperBound = std::sqrt(std::max(0.0, out.meanSquare + 2.0 * out.meanSquareError));
     out.texels = count;
+    out.coveredTexels = covered;
     out.spp = meanSpp;
     for (size_t i = 0; i < ids.size(); ++i) out.paths += int64_t(checked[i]) * (options.pilotSpp + 2 * int64_t(spp[i]));
     out.seconds = secondsSince(t0);

@@ -55,6 +55,10 @@ struct ErrorCheckOptions {
     int fallbackSpp = 0;
     double expectedError = 0;
     int pilotSpp = 16;           // paths per texel of the pilot
+    // At most this many texels (0: all), a uniform random subset of them: the estimate stays unbiased
+    // and its standard error follows the texels checked (a subset's seams are stitched against the
+    // bake's values at the texels left out).
+    int64_t maxTexels = 1 << 16;
     bool stitchSeams = true;     // the bake's seams were stitched (bake/seam_stitch.h): stitch the estimates'
 };
 
@@ -63,7 +67,8 @@ struct ErrorCheck {
     double meanSquare = 0;       // the estimated mean squared error over the reference's mean squared (may be < 0)
     double meanSquareError = 0;  // its standard error (from the spread of the texels' products)
     double upperBound = 0;       // sqrt(meanSquare + 2 meanSquareError): relRmse's upper bound at about 98 %
-    int64_t texels = 0;        // covered in both the maps and the reference
+    int64_t texels = 0;         // checked (covered in both the maps and the reference; a subset of them)
+    int64_t coveredTexels = 0;  // covered in both
     int spp = 0;               // mean paths per texel per estimate, as traced
     int64_t paths = 0;         // traced, pilot included
     double seconds = 0;        // BVH, coverage and tracing

@@ -67,6 +67,23 @@ TEST(ErrorCheck, MeasuresAKnownNoisePattern) {
     EXPECT_EQ(c.texels, k);
 }
 
+// A subset of the texels (a large map's): the same estimate, over fewer texels.
+TEST(ErrorCheck, ASubsetOfTheTexelsMeasuresTheSame) {
+    Furnace f = furnace();
+    LightmapPages maps = f.truth;
+    int k = 0;
+    for (size_t i = 0; i < maps.covered[0].size(); ++i)
+        if (maps.covered[0][i]) maps.pages[0].pixels[i] *= (k++ % 2 == 0 ? 1.03f : 0.97f);
+    ErrorCheckOptions o;
+    o.maxTexels = k / 2;
+    const ErrorCheck c = check(f, maps, o);
+    EXPECT_EQ(c.coveredTexels, k);
+    EXPECT_NEAR(double(c.texels), k / 2.0, 4.0 * std::sqrt(k / 4.0)) << "a binomial draw of half the texels";
+    const double truth = 0.03 * 0.03;
+    EXPECT_LT(c.meanSquareError, truth / 4) << "too few paths for the test to tell";
+    EXPECT_NEAR(c.meanSquare, truth, 4 * c.meanSquareError);
+}
+
 // Every texel 2 % high: the error is all bias, which the bake's own noise
 // estimate (the two halves of the directions) cannot see; the check does.
 TEST(ErrorCheck, MeasuresABias) {
