@@ -124,29 +124,35 @@ Expected<ErrorCheck> checkError(const Scene& scene, const Layout& layout, const 
     // (both linear: the truth's image under them is what the bake's maps estimate). Covered texels not
     // checked (a subset; the few the reference does not cover) hold the bake's values, so that a seam
     // through them is stitched against what the bake has there.
-    std::array<LightmapPages, 2> estimates;
+    // Each is kept at the checked texels only (a large map's pages are made one at a time).
+    std::array<std::vector<glm::dvec3>, 2> estimates;
     const size_t perPage = size_t(layout.resolution) * layout.resolution;
-    std::vector<std::vector<glm::vec4>> baked(size_t(layout.pageCount), std::vector<glm::vec4>(perPage, glm::vec4(0.0f)));
-    for (size_t p = 0; p < baked.size() && p < maps.pages.size(); ++p)
-        for (size_t t = 0; t < perPage; ++t)
-            if (maps.covered[p][t]) baked[p][t] = glm::vec4(maps.pages[p].pixels[t], 1.0f);
     for (int e = 0; e < 2; ++e) {
         const std::vector<glm::dvec4> sums = r.sampleTexels(hash(seed, uint64_t(e) + 1), spp);
-        std::vector<std::vector<glm::vec4>> pages = baked;
+        LightmapPages pages;
+        pages.resolution = layout.resolution;
+        pages.covered = maps.covered;
+        for (size_t p = 0; p < size_t(layout.pageCount); ++p) {
+            std::vector<glm::vec4> page(perPage, glm::vec4(0.0f));
+            for (size_t t = 0; p < maps.pages.size() && t < perPage; ++t)
+                if (maps.covered[p][t]) page[t] = glm::vec4(maps.pages[p].pixels[t], 1.0f);
+            for (size_t i = 0; i < ids.size(); ++i)
+                if (checked[i] && ids[i].page == p)
+                    page[ids[i].index] = glm::vec4(glm::vec3(glm::dvec3(sums[i]) / double(spp[i])), 1.0f);
+            pages.pages.push_back(dilatedImage(std::move(page), layout.resolution, layout.padding + 1));
+        }
+        if (options.stitchSeams) stitchSeams(pages, findSeams(r.mesh(), layout.resolution));
         for (size_t i = 0; i < ids.size(); ++i)
-            if (checked[i]) pages[ids[i].page][ids[i].index] = glm::vec4(glm::vec3(glm::dvec3(sums[i]) / double(spp[i])), 1.0f);
-        estimates[e].resolution = layout.resolution;
-        for (auto& page : pages) estimates[e].pages.push_back(dilatedImage(std::move(page), layout.resolution, layout.padding + 1));
-        estimates[e].covered = maps.covered;
-        if (options.stitchSeams) stitchSeams(estimates[e], findSeams(r.mesh(), layout.resolution));
+            if (checked[i]) estimates[e].push_back(glm::dvec3(pages.pages[ids[i].page].pixels[ids[i].index]));
     }
     std::vector<double> products;
     products.reserve(size_t(count));
     double referenceSum = 0.0;
-    for (size_t i = 0; i < ids.size(); ++i) {
+    for (size_t i = 0, k = 0; i < ids.size(); ++i) {
         if (!checked[i]) continue;
-        const auto at = [&](const LightmapPages& m) { return glm::dvec3(m.pages[ids[i].page].pixels[ids[i].index]); };
-        const glm::dvec3 baked = at(maps), a = at(estimates[0]), b = at(estimates[1]);
+        const glm::dvec3 baked(maps.pages[ids[i].page].pixels[ids[i].index]);
+        const glm::dvec3 a = estimates[0][k], b = estimates[1][k];
+        ++k;
         const glm::dvec3 ea = baked - a, eb = baked - b;
         products.push_back((ea.x * eb.x + ea.y * eb.y + ea.z * eb.z) / 3.0);
         referenceSum += (a.x + a.y + a.z + b.x + b.y + b.z) / 6.0;
