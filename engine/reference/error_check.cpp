@@ -30,6 +30,37 @@ std::string ErrorCheck::summary() const {
 
 namespace {
 constexpr double kNominalRays = 6.0;  // rays a path of the bench's scenes takes at most (1.7-5.7, shadow rays included)
+
+// One estimate of the checked texels (spp[i] paths of texel i under `seed`) as
+// light maps: dilated into the padding and its seams stitched as the bake's
+// were (both linear: the truth's image under them is what the bake's maps
+// estimate). Covered texels not checked (a subset; the few the reference does
+// not cover) hold the bake's values, so that a seam through them is stitched
+// against what the bake has there. Kept at the checked texels only, in ids'
+// order (a large map's pages are made one at a time).
+std::vector<glm::dvec3> stitchedEstimate(ReferenceBaker& r, const Layout& layout, const LightmapPages& maps,
+                                         const std::vector<TexelId>& ids, const std::vector<uint8_t>& checked,
+                                         const std::vector<uint32_t>& spp, uint64_t seed, bool stitch) {
+    const std::vector<glm::dvec4> sums = r.sampleTexels(seed, spp);
+    const size_t perPage = size_t(layout.resolution) * layout.resolution;
+    LightmapPages pages;
+    pages.resolution = layout.resolution;
+    pages.covered = maps.covered;
+    for (size_t p = 0; p < size_t(layout.pageCount); ++p) {
+        std::vector<glm::vec4> page(perPage, glm::vec4(0.0f));
+        for (size_t t = 0; p < maps.pages.size() && t < perPage; ++t)
+            if (maps.covered[p][t]) page[t] = glm::vec4(maps.pages[p].pixels[t], 1.0f);
+        for (size_t i = 0; i < ids.size(); ++i)
+            if (checked[i] && ids[i].page == p)
+                page[ids[i].index] = glm::vec4(glm::vec3(glm::dvec3(sums[i]) / double(spp[i])), 1.0f);
+        pages.pages.push_back(dilatedImage(std::move(page), layout.resolution, layout.padding + 1));
+    }
+    if (stitch) stitchSeams(pages, findSeams(r.mesh(), layout.resolution));
+    std::vector<glm::dvec3> out;
+    for (size_t i = 0; i < ids.size(); ++i)
+        if (checked[i]) out.push_back(glm::dvec3(pages.pages[ids[i].page].pixels[ids[i].index]));
+    return out;
+}
 }  // namespace
 
 void setAutoBudget(ErrorCheckOptions& options, int directions, double bakeEstimate) {
@@ -120,31 +151,9 @@ Expected<ErrorCheck> checkError(const Scene& scene, const Layout& layout, const 
         }
     }
 
-    // the two estimates as light maps: dilated into the padding and their seams stitched as the bake's were
-    // (both linear: the truth's image under them is what the bake's maps estimate). Covered texels not
-    // checked (a subset; the few the reference does not cover) hold the bake's values, so that a seam
-    // through them is stitched against what the bake has there.
-    // Each is kept at the checked texels only (a large map's pages are made one at a time).
-    std::array<std::vector<glm::dvec3>, 2> estimates;
-    const size_t perPage = size_t(layout.resolution) * layout.resolution;
-    for (int e = 0; e < 2; ++e) {
-        const std::vector<glm::dvec4> sums = r.sampleTexels(hash(seed, uint64_t(e) + 1), spp);
-        LightmapPages pages;
-        pages.resolution = layout.resolution;
-        pages.covered = maps.covered;
-        for (size_t p = 0; p < size_t(layout.pageCount); ++p) {
-            std::vector<glm::vec4> page(perPage, glm::vec4(0.0f));
-            for (size_t t = 0; p < maps.pages.size() && t < perPage; ++t)
-                if (maps.covered[p][t]) page[t] = glm::vec4(maps.pages[p].pixels[t], 1.0f);
-            for (size_t i = 0; i < ids.size(); ++i)
-                if (checked[i] && ids[i].page == p)
-                    page[ids[i].index] = glm::vec4(glm::vec3(glm::dvec3(sums[i]) / double(spp[i])), 1.0f);
-            pages.pages.push_back(dilatedImage(std::move(page), layout.resolution, layout.padding + 1));
-        }
-        if (options.stitchSeams) stitchSeams(pages, findSeams(r.mesh(), layout.resolution));
-        for (size_t i = 0; i < ids.size(); ++i)
-            if (checked[i]) estimates[e].push_back(glm::dvec3(pages.pages[ids[i].page].pixels[ids[i].index]));
-    }
+    const std::array<std::vector<glm::dvec3>, 2> estimates = {
+        stitchedEstimate(r, layout, maps, ids, checked, spp, hash(seed, 1), options.stitchSeams),
+        stitchedEstimate(r, layout, maps, ids, checked, spp, hash(seed, 2), options.stitchSeams)};
     std::vector<double> products;
     products.reserve(size_t(count));
     double referenceSum = 0.0;
