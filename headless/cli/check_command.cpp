@@ -22,7 +22,7 @@ struct CheckArgs {
     int threads = 0;
     uint64_t seed = 1;
     std::string sky, env;  // empty: as BAKE_DIR/stats.json's settings say
-    std::string seams;     // empty: as BAKE_DIR/stats.json's settings say (stitch if it does not)
+    std::string seams;     // empty: as BAKE_DIR/stats.json's settings say (off if they do not: the viewer's saves)
     bool json = false;
 };
 
@@ -65,7 +65,7 @@ int runCheck(CheckArgs args) {
     } else {
         options.spp = std::atoi(args.spp.c_str());
     }
-    options.stitchSeams = args.seams != "off";
+    options.stitchSeams = args.seams == "stitch";
     auto loaded = loadSceneWithBakeLayout(args.scene, args.given, args.bakeDir);
     if (!loaded) return fail(loaded.error());
     auto maps = readBakedLightmaps(args.bakeDir, loaded->layout);
@@ -102,7 +102,7 @@ void addCheckCommand(CLI::App& app, std::function<int()>& action) {
     cmd->add_option("--sky", a->sky, "Uniform sky radiance r,g,b (default: the bake's, from its stats.json)");
     cmd->add_option("--env", a->env, "Equirectangular environment map (default: the bake's)")
         ->excludes(cmd->get_option("--sky"));
-    cmd->add_option("--seams", a->seams, "The bake's seams: stitch or off (default: the bake's)")
+    cmd->add_option("--seams", a->seams, "The bake's seams: stitch or off (default: as its stats.json says; off where it does not say)")
         ->check(CLI::IsMember({"stitch", "off"}));
     cmd->add_flag("--json", a->json, "Print the figures as JSON");
     cmd->callback([a, cmd, &action] {
