@@ -33,6 +33,7 @@
 
 #include "bake/bake_output.h"
 #include "bake/baker.h"
+#include "bake/seam_stitch.h"
 #include "core/timer.h"
 #include "core/log.h"
 #include "core/memory.h"
@@ -334,9 +335,14 @@ Status Viewer::saveLightmaps(const std::string& dir) {
                      {"sky", args_.sky}, {"env", args_.env}, {"rounding", args_.rounding},
                      {"uv_layout", args_.scene.uvLayout}, {"resolution", args_.scene.resolution},
                      {"texel_density", args_.scene.texelDensity}, {"history_power", baker_->stats().historyPower},
-                     {"history_plateau", baker_->stats().historyPlateau}, {"supersample", args_.supersample}};
+                     {"history_plateau", baker_->stats().historyPlateau}, {"supersample", args_.supersample},
+                     {"seams", "stitch"}};
     info.wallSeconds = bakeSeconds_;
-    return writeBakeOutputs(dir, loaded_.scene, loaded_.layout, baker_->readLightmaps(), baker_->stats().toJson(), info);
+    // as `bundlebake bake` writes them: the seams stitched (its default)
+    LightmapPages maps = baker_->readLightmaps();
+    nlohmann::json stats = baker_->stats().toJson();
+    stats["seams"] = stitchSeams(maps, findSeams(baker_->mesh(), maps.resolution)).toJson();
+    return writeBakeOutputs(dir, loaded_.scene, loaded_.layout, maps, stats, info);
 }
 
 void Viewer::handleInput(double dt) {

@@ -12,6 +12,8 @@
 #include <string>
 
 #include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
 #include <unistd.h>
 
 #include "render/scene_renderer.h"
@@ -33,7 +35,7 @@ TEST(ViewerXvfb, ScriptedScreenshotShowsTheLitScene) {
     const std::string shot = dir + "/shot.png", log = dir + "/viewer.log";
     const std::string command = "xvfb-run -a -s '-screen 0 1280x720x24' '" + std::string(BUNDLEBAKE_VIEWER) + "' '" +
                                 sourcePath("assets/cornell_box/cornell_box.gltf") + "' --screenshot '" + shot +
-                                "' --frames 60 > '" + log + "' 2>&1";
+                                "' --frames 60 --save-lightmaps --output '" + dir + "/maps' > '" + log + "' 2>&1";
     const int status = std::system(command.c_str());
     std::stringstream output;
     output << std::ifstream(log).rdbuf();
@@ -56,6 +58,11 @@ TEST(ViewerXvfb, ScriptedScreenshotShowsTheLitScene) {
     std::printf("centre region: mean luma %.1f, max %d (of 255)\n", mean, brightest);
     EXPECT_GT(mean, 60.0) << "the centre of the screenshot is not lit";
     EXPECT_GT(brightest, 120);
+    // the saved light maps are written as `bundlebake bake` writes them: their seams stitched
+    const nlohmann::json stats = nlohmann::json::parse(std::ifstream(dir + "/maps/stats.json"), nullptr, false);
+    ASSERT_TRUE(stats.is_object()) << "no stats.json beside the saved light maps";
+    EXPECT_EQ(stats["settings"].value("seams", ""), "stitch");
+    EXPECT_TRUE(stats.contains("seams") && stats["seams"].contains("seam_edges")) << "the seams were not stitched";
     std::filesystem::remove_all(dir);
 #endif
 }
