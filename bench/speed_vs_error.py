@@ -419,7 +419,7 @@ def converged_reference(exe, name, cfg):
 
 CSV_FIELDS = ["scene", "method", "param", "value", "seconds", "process_seconds", "rel_rmse", "rmse", "rel_mse",
               "mean_ratio", "max_abs", "texels", "noise_estimate", "resolution_estimate", "check_estimate",
-              "check_bound", "check_seconds"]
+              "check_bound", "check_seconds", "rounding_estimate"]
 
 
 def sweep_point(exe, name, cfg, method, value, ref):
@@ -446,6 +446,7 @@ def sweep_point(exe, name, cfg, method, value, ref):
            "resolution_estimate": s.get("noise", {}).get("resolution", "") if method == "bundlebake" else ""}
     if method == "bundlebake":
         row.update(check_columns(s.get("noise", {}).get("check")))
+        row["rounding_estimate"] = s.get("noise", {}).get("output_rounding", "")
     log("[%s] %-10s %-10s %6d: %7.3f s (process %6.2f s) rel_rmse %.4f mean_ratio %.4f" %
         (name, method, row["param"], value, seconds, wall, c["rel_rmse"], c["mean_ratio"]))
     return row
@@ -575,6 +576,8 @@ def write_outputs(name, cfg, rows, ref_note, ref_seconds, measured=None):
             check = "< %.4f" % r["check_bound"]
         if r.get("check_seconds", "") != "":
             check_seconds = "%.1f" % r["check_seconds"]
+        if error_estimate != "" and r.get("rounding_estimate", "") != "":  # the written maps' half rounding
+            error_estimate = math.hypot(error_estimate, r["rounding_estimate"])
         with_resolution = "%.2f" % (error_estimate / own) if error_estimate != "" and own > 0 else "-"
         # both errors against the truth: the sweep's runs are as independent of the
         # converged reference's noise as the bake is
@@ -599,7 +602,7 @@ def write_outputs(name, cfg, rows, ref_note, ref_seconds, measured=None):
                  "(b - A)(b - B) over the texels for two independent path-traced estimates A, B of each (`bundlebake "
                  "check`, bias and noise alike), where conclusive (3 standard errors above 0; else its upper bound, "
                  "'< x'), and its seconds (after the bake, outside its time). Error estimate / error: noise.error_estimate "
-                 "(the check where conclusive, else the noise and the probe added in quadrature) over the error. Less "
+                 "(the check where conclusive, else the noise and the probe added in quadrature; since 2026-12-07 with the written maps' half-float rounding, noise.output_rounding, added in quadrature) over the error. Less "
                  "the reference's noise: sqrt(rel_rmse^2 - its noise^2), the bake's error against the truth (the two "
                  "are independent); estimate / error is the estimate over it (the goal: within 1.5x either way).")
     lines.append("")
@@ -620,7 +623,7 @@ def rewrite_tables(name, cfg):
             r[k] = float(r[k])
         r["noise_estimate"] = float(r["noise_estimate"]) if r["noise_estimate"] else ""
         r["resolution_estimate"] = float(r["resolution_estimate"]) if r.get("resolution_estimate") else ""
-        for k in ("check_estimate", "check_bound", "check_seconds"):
+        for k in ("check_estimate", "check_bound", "check_seconds", "rounding_estimate"):
             r[k] = float(r[k]) if r.get(k) else ""
     with open(os.path.join(outdir, "table.md")) as f:
         head = f.read()

@@ -31,6 +31,13 @@ struct BakeOutputInfo {
 Status writeBakeOutputs(const std::string& outDir, const Scene& scene, const Layout& layout, const LightmapPages& maps,
                         nlohmann::json stats, const BakeOutputInfo& info);
 
+// The light maps' error from being written as half floats (writeExr): the
+// RMS of (stored - value) over the covered texels and the 3 channels, over
+// their mean (rel_rmse's measure). Exact, not an estimate: a part of the
+// written maps' error that the bake's own estimates do not hold (the rho 0.5
+// furnace's values sit just under 2, where half's step is 0.049 %).
+double exrRoundingError(const LightmapPages& maps);
+
 // Coverage mask file name: "coverage_<page>.png".
 std::string coverageFileName(int page);
 

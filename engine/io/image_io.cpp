@@ -173,6 +173,8 @@ void flipRows(ImageRgb& image) {
     }
 }
 
+float exrStoredValue(float v, float largest) { return largest > 65504.0f ? v : float(half(v)); }
+
 Status writeExr(const std::string& path, const ImageRgb& image,
                     const std::vector<std::pair<std::string, std::string>>& attributes) {
     if (Status s = checkImage(image); !s) return Status::error("cannot write " + path + ": " + s.message());

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <csignal>
 #include <cstdio>
@@ -260,6 +261,8 @@ int runBake(const BakeArgs& args) {
     if (mpi) stats["mpi"] = mpiFigures;
     if (args.seams == "stitch")
         stats["seams"] = stitchSeams(maps, findSeams((*baker)->mesh(), maps.resolution)).toJson();
+    // the error estimate: the bake's own (noise, lag, resolution probe), or the path-traced check where conclusive
+    double estimate = (*baker)->stats().errorEstimate();
     if (args.errorCheck != "off") {  // on the maps as written
         ErrorCheckOptions check;
         check.reference.seed = args.seed;
@@ -274,9 +277,13 @@ int runBake(const BakeArgs& args) {
         auto result = checkError(loaded->scene, loaded->layout, maps, check);
         if (!result) return fail(result.error());
         stats["noise"]["check"] = result->toJson();
-        if (result->conclusive()) stats["noise"]["error_estimate"] = result->relRmse;
+        if (result->conclusive()) estimate = result->relRmse;
         logInfo(result->summary());
     }
+    // the written maps' half-float rounding, exact, added to whichever estimate stands
+    const double rounding = exrRoundingError(maps);
+    stats["noise"]["output_rounding"] = rounding;
+    if (estimate >= 0) stats["noise"]["error_estimate"] = std::hypot(estimate, rounding);
     if (Status s = writeBakeOutputs(args.outDir, loaded->scene, loaded->layout, maps, stats, info); !s)
         return fail(s.message());
     if (args.checkpointEvery > 0 || args.resume) std::filesystem::remove(checkpoint);  // the outputs supersede it

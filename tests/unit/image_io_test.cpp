@@ -17,6 +17,7 @@
 #include <ImfInputFile.h>
 #include <ImfStringAttribute.h>
 
+#include "bake/bake_output.h"
 #include "bake/rounding.h"
 #include "io/image_io.h"
 #include "io/stb_codec.h"
@@ -86,6 +87,30 @@ TEST_F(ImageIo, ExrRoundTripIsExactToHalf) {
         }
     }
     EXPECT_TRUE(leftovers().empty());
+}
+
+// The written maps' half rounding (bake_output.h exrRoundingError), against
+// the values written and read back: a page just under 2 (the rho 0.5
+// furnace's) loses 1.9991 - 1.99902 on every texel; a page beyond half's range
+// is written as float and loses nothing; padding is left out.
+TEST_F(ImageIo, ExrRoundingErrorIsWhatTheFileLoses) {
+    LightmapPages maps;
+    maps.resolution = 4;
+    maps.pages.resize(1);
+    maps.pages[0].width = maps.pages[0].height = 4;
+    maps.pages[0].pixels.assign(16, glm::vec3(1.9991f));
+    maps.pages[0].pixels[15] = glm::vec3(7.0f);  // padding
+    maps.covered = {std::vector<uint8_t>(16, 1)};
+    maps.covered[0][15] = 0;
+    const std::string file = path("rounding.exr");
+    ASSERT_TRUE(writeExr(file, maps.pages[0]).isOk());
+    Expected<ImageRgb> back = readImageRgb(file);
+    ASSERT_TRUE(back) << back.error();
+    const double lost = std::fabs(double(back->pixels[0].r) - double(1.9991f));
+    EXPECT_GT(lost, 0.0);
+    EXPECT_NEAR(exrRoundingError(maps), lost / double(1.9991f), 1e-9);
+    maps.pages[0].pixels[15] = glm::vec3(1e5f);  // the page is written as float now
+    EXPECT_EQ(exrRoundingError(maps), 0.0);
 }
 
 TEST_F(ImageIo, ExrIsZipHalfRgbWithAttributes) {
