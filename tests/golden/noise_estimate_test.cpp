@@ -303,7 +303,6 @@ TEST(NoiseEstimate, ErrorCheckSeesTheSharedBoxsSlotBias) {
     EXPECT_TRUE(noise["check"]["conclusive"].get<bool>());
     // the estimate is the check, with the written maps' half rounding
     EXPECT_NEAR(noise["error_estimate"].get<double>(), std::hypot(check, noise["output_rounding"].get<double>()), 1e-12);
-    EXPECT_LT(noise["output_rounding"].get<double>(), 0.001);
     EXPECT_GE(check, truth / 1.5) << "the check is too low";
     EXPECT_LE(check, truth * 1.5) << "the check is too high";
 
