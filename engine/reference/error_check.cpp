@@ -31,15 +31,15 @@ std::string ErrorCheck::summary() const {
 namespace {
 constexpr double kNominalRays = 6.0;  // rays a path of the bench's scenes takes at most (1.7-5.7, shadow rays included)
 
-// One estimate of the checked texels (spp[i] paths of texel i under `seed`) as
+// One estimate of the checked texels ids (spp[i] paths of texel i under `seed`) as
 // light maps: dilated into the padding and its seams stitched as the bake's
 // were (both linear: the truth's image under them is what the bake's maps
-// estimate). Covered texels not checked (a subset; the few the reference does
-// not cover) hold the bake's values, so that a seam through them is stitched
+// estimate). Covered texels not checked (a large map's subset; the few the
+// reference does not cover) hold the bake's values, so that a seam through them is stitched
 // against what the bake has there. Kept at the checked texels only, in ids'
 // order (a large map's pages are made one at a time).
 std::vector<glm::dvec3> stitchedEstimate(ReferenceBaker& r, const Layout& layout, const LightmapPages& maps,
-                                         const std::vector<TexelId>& ids, const std::vector<uint8_t>& checked,
+                                         const std::vector<TexelId>& ids,
                                          const std::vector<uint32_t>& spp, uint64_t seed, bool stitch) {
     const std::vector<glm::dvec4> sums = r.sampleTexels(seed, spp);
     const size_t perPage = size_t(layout.resolution) * layout.resolution;
@@ -51,14 +51,14 @@ std::vector<glm::dvec3> stitchedEstimate(ReferenceBaker& r, const Layout& layout
         for (size_t t = 0; p < maps.pages.size() && t < perPage; ++t)
             if (maps.covered[p][t]) page[t] = glm::vec4(maps.pages[p].pixels[t], 1.0f);
         for (size_t i = 0; i < ids.size(); ++i)
-            if (checked[i] && ids[i].page == p)
+            if (ids[i].page == p)
                 page[ids[i].index] = glm::vec4(glm::vec3(glm::dvec3(sums[i]) / double(spp[i])), 1.0f);
         pages.pages.push_back(dilatedImage(std::move(page), layout.resolution, layout.padding + 1));
     }
     if (stitch) stitchSeams(pages, findSeams(r.mesh(), layout.resolution));
     std::vector<glm::dvec3> out;
     for (size_t i = 0; i < ids.size(); ++i)
-        if (checked[i]) out.push_back(glm::dvec3(pages.pages[ids[i].page].pixels[ids[i].index]));
+        out.push_back(glm::dvec3(pages.pages[ids[i].page].pixels[ids[i].index]));
     return out;
 }
 }  // namespace
@@ -75,43 +75,32 @@ Expected<ErrorCheck> checkError(const Scene& scene, const Layout& layout, const 
     const auto t0 = Clock::now();
     ReferenceOptions ro = options.reference;
     ro.spp = 1;
+    // the bake's covered texels; of a large map a uniform random subset, by a hash of each texel (the
+    // same for any run), which the reference alone sets up (its footprints cost memory per texel)
+    int64_t covered = 0;
+    for (const auto& page : maps.covered)
+        for (uint8_t c : page) covered += c != 0;
+    const double keep = options.maxTexels > 0 && covered > options.maxTexels ? double(options.maxTexels) / double(covered) : 1.0;
+    ro.texelFilter = [&maps, keep, seed = ro.seed](uint32_t page, uint32_t index) {
+        if (page >= maps.covered.size() || !maps.covered[page][index]) return false;
+        return keep >= 1.0 || double(hash(seed, 0x5B5E7ull, uint64_t(page) << 32 | index) >> 11) * 0x1p-53 < keep;
+    };
     auto reference = ReferenceBaker::create(scene, layout, ro);
     if (!reference) return reference.status();
     ReferenceBaker& r = **reference;
-
-    // the texels covered in both
+    // the texels checked: covered in both (and picked)
     const std::vector<TexelId> ids = r.coveredTexels();
-    std::vector<uint8_t> checked(ids.size(), 0);
-    int64_t count = 0;
-    for (size_t i = 0; i < ids.size(); ++i) {
-        const TexelId& t = ids[i];
-        checked[i] = t.page < maps.covered.size() && maps.covered[t.page][t.index] != 0;
-        count += checked[i];
-    }
+    const int64_t count = int64_t(ids.size());
     if (count == 0) return Status::error("error check: no texel is covered in both the bake and the reference");
-    // a large map: a uniform random subset of its texels (by a hash of each, so the same for any run)
-    const int64_t covered = count;
-    if (options.maxTexels > 0 && count > options.maxTexels) {
-        const double keep = double(options.maxTexels) / double(count);
-        count = 0;
-        for (size_t i = 0; i < ids.size(); ++i) {
-            const uint64_t h = hash(ro.seed, 0x5B5E7ull, uint64_t(ids[i].page) << 32 | ids[i].index);
-            checked[i] = checked[i] && double(h >> 11) * 0x1p-53 < keep;
-            count += checked[i];
-        }
-        if (count == 0) return Status::error("error check: the subset of texels is empty");
-    }
 
     // pilot: each texel's samples' second moment sets its share of the budget
     const uint64_t seed = hash(ro.seed, 0xE220C4EC4ull);
-    std::vector<uint32_t> spp(ids.size(), 0);
-    for (size_t i = 0; i < ids.size(); ++i) spp[i] = checked[i] ? uint32_t(options.pilotSpp) : 0u;
+    std::vector<uint32_t> spp(ids.size(), uint32_t(options.pilotSpp));
     const std::vector<glm::dvec4> pilot = r.sampleTexels(hash(seed, 0), spp);
     std::vector<double> weight(ids.size(), 0.0);
     double weightSum = 0.0;
     const double n0 = options.pilotSpp;
     for (size_t i = 0; i < ids.size(); ++i) {
-        if (!checked[i]) continue;
         weight[i] = std::pow(pilot[i].w / n0, 2.0 / 3.0);
         weightSum += weight[i];
     }
@@ -121,7 +110,7 @@ Expected<ErrorCheck> checkError(const Scene& scene, const Layout& layout, const 
         const double floorSpp = std::max(2.0, 0.25 * meanSpp);
         const double share = weightSum > 0.0 ? (budget - floorSpp * double(count)) / weightSum : 0.0;
         for (size_t i = 0; i < ids.size(); ++i)
-            if (checked[i]) spp[i] = uint32_t(std::min(floorSpp + std::floor(share * weight[i]), double(1 << 24)));
+            spp[i] = uint32_t(std::min(floorSpp + std::floor(share * weight[i]), double(1 << 24)));
     };
     // the budget is in rays: paths longer than kNominalRays (a high albedo's) get proportionally fewer
     const ReferenceStats& traced = r.stats();
@@ -136,8 +125,7 @@ Expected<ErrorCheck> checkError(const Scene& scene, const Layout& layout, const 
         // be conclusive, and the fallback's bound is worth as much
         double squares = 0.0, sum = 0.0;
         for (size_t i = 0; i < ids.size(); ++i) {
-            if (!checked[i]) continue;
-            const double texelMean = (pilot[i].x + pilot[i].y + pilot[i].z) / (3.0 * n0);
+                const double texelMean = (pilot[i].x + pilot[i].y + pilot[i].z) / (3.0 * n0);
             const double s = std::max(0.0, (pilot[i].w - n0 * texelMean * texelMean) / (n0 - 1.0)) / double(spp[i]);
             squares += s * s;
             sum += texelMean;
@@ -152,16 +140,14 @@ Expected<ErrorCheck> checkError(const Scene& scene, const Layout& layout, const 
     }
 
     const std::array<std::vector<glm::dvec3>, 2> estimates = {
-        stitchedEstimate(r, layout, maps, ids, checked, spp, hash(seed, 1), options.stitchSeams),
-        stitchedEstimate(r, layout, maps, ids, checked, spp, hash(seed, 2), options.stitchSeams)};
+        stitchedEstimate(r, layout, maps, ids, spp, hash(seed, 1), options.stitchSeams),
+        stitchedEstimate(r, layout, maps, ids, spp, hash(seed, 2), options.stitchSeams)};
     std::vector<double> products;
     products.reserve(size_t(count));
     double referenceSum = 0.0;
-    for (size_t i = 0, k = 0; i < ids.size(); ++i) {
-        if (!checked[i]) continue;
+    for (size_t i = 0; i < ids.size(); ++i) {
         const glm::dvec3 baked(maps.pages[ids[i].page].pixels[ids[i].index]);
-        const glm::dvec3 a = estimates[0][k], b = estimates[1][k];
-        ++k;
+        const glm::dvec3 a = estimates[0][i], b = estimates[1][i];
         const glm::dvec3 ea = baked - a, eb = baked - b;
         products.push_back((ea.x * eb.x + ea.y * eb.y + ea.z * eb.z) / 3.0);
         referenceSum += (a.x + a.y + a.z + b.x + b.y + b.z) / 6.0;
@@ -184,7 +170,7 @@ Expected<ErrorCheck> checkError(const Scene& scene, const Layout& layout, const 
     out.texels = count;
     out.coveredTexels = covered;
     out.spp = meanSpp;
-    for (size_t i = 0; i < ids.size(); ++i) out.paths += int64_t(checked[i]) * (options.pilotSpp + 2 * int64_t(spp[i]));
+    for (size_t i = 0; i < ids.size(); ++i) out.paths += (options.pilotSpp + 2 * int64_t(spp[i]));
     out.seconds = secondsSince(t0);
     return out;
 }

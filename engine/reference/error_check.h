@@ -68,7 +68,7 @@ struct ErrorCheck {
     double meanSquareError = 0;  // its standard error (from the spread of the texels' products)
     double upperBound = 0;       // sqrt(meanSquare + 2 meanSquareError): relRmse's upper bound at about 98 %
     int64_t texels = 0;         // checked (covered in both the maps and the reference; a subset of them)
-    int64_t coveredTexels = 0;  // covered in both
+    int64_t coveredTexels = 0;  // covered in the bake
     int spp = 0;               // mean paths per texel per estimate, as traced
     int64_t paths = 0;         // traced, pilot included
     double seconds = 0;        // BVH, coverage and tracing

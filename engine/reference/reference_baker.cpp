@@ -358,7 +358,7 @@ void ReferenceBaker::Impl::findTexels() {
         std::vector<int64_t> slot(owner.size(), -1);  // texel -> index into texels
         const size_t firstTexel = texels.size();
         for (size_t i = 0; i < owner.size(); ++i) {
-            if (owner[i] < 0) continue;
+            if (owner[i] < 0 || (options.texelFilter && !options.texelFilter(uint32_t(page), uint32_t(i)))) continue;
             slot[i] = int64_t(texels.size());
             Texel texel;
             texel.page = uint32_t(page);
@@ -379,7 +379,7 @@ void ReferenceBaker::Impl::findTexels() {
             for (int y = y0; y <= y1; ++y)
                 for (int x = x0; x <= x1; ++x) {
                     const size_t i = size_t(y) * res + x;
-                    if (owner[i] < 0 || chart[size_t(owner[i])] != chart[t]) continue;
+                    if (slot[i] < 0 || chart[size_t(owner[i])] != chart[t]) continue;
                     const glm::dvec2 origin(x, y);
                     const glm::dvec2 local[3] = {q[0] - origin, q[1] - origin, q[2] - origin};
                     const std::vector<glm::dvec2> poly = clipSquare(local);

@@ -75,6 +75,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -106,6 +107,9 @@ struct ReferenceOptions {
     bool emitterSampling = true;    // next-event estimation of emissive triangles (with MIS)
     int rouletteDepth = 3;          // bounces before Russian roulette starts; typ. 2..5
     int maxBounces = 1000;          // safety cap on path length (roulette ends paths long before)
+    // Which covered texels to bake (page, y * resolution + x); empty: all. The others are neither
+    // traced nor held (the error check's subset of a large map: reference/error_check.h).
+    std::function<bool(uint32_t page, uint32_t index)> texelFilter;
 };
 
 struct ReferenceStats {
