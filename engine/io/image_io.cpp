@@ -173,22 +173,26 @@ void flipRows(ImageRgb& image) {
     }
 }
 
-float exrStoredValue(float v, float largest) { return largest > 65504.0f ? v : float(half(v)); }
+bool exrWritesFloat(const ImageRgb& image) {
+    float largest = 0.0f;
+    for (const glm::vec3& p : image.pixels) largest = std::max({largest, p.r, p.g, p.b});
+    return largest > 65504.0f;
+}
+
+float exrStoredValue(float v, bool asFloat) { return asFloat ? v : float(half(v)); }
 
 Status writeExr(const std::string& path, const ImageRgb& image,
                     const std::vector<std::pair<std::string, std::string>>& attributes) {
     if (Status s = checkImage(image); !s) return Status::error("cannot write " + path + ": " + s.message());
     // half, unless a value is beyond half's range (65504): then float, never a clamp
-    float largest = 0.0f;
-    for (const glm::vec3& p : image.pixels) largest = std::max({largest, p.r, p.g, p.b});
-    const bool asFloat = largest > 65504.0f;
+    const bool asFloat = exrWritesFloat(image);
     static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "ImageRgb pixels must be packed RGB floats");
     // float -> half rounds to nearest, ties to even (Imath)
     std::vector<half> halves;
     if (!asFloat) {
         halves.resize(image.pixels.size() * 3);
         for (size_t i = 0; i < image.pixels.size(); ++i)
-            for (int c = 0; c < 3; ++c) halves[3 * i + size_t(c)] = half(image.pixels[i][c]);
+            for (int c = 0; c < 3; ++c) halves[3 * i + size_t(c)] = half(image.pixels[i][c]);  // exrStoredValue
     }
     return writeThroughTemp(path, [&](const std::string& temp) {
         try {

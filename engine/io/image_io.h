@@ -32,10 +32,11 @@ void flipRows(ImageRgb& image);
 // value is beyond half's range (65504), so nothing is clamped.
 Status writeExr(const std::string& path, const ImageRgb& image,
                     const std::vector<std::pair<std::string, std::string>>& attributes = {});
-// The value writeExr stores for v in an image whose largest value is
-// `largest`: v rounded to half (nearest, ties to even), or v itself where the
-// image is written as float.
-float exrStoredValue(float v, float largest);
+// Whether writeExr writes `image` as 32-bit floats (a value beyond half's range).
+bool exrWritesFloat(const ImageRgb& image);
+// The value writeExr stores for v: v rounded to half (nearest, ties to even),
+// or v itself in an image written as float.
+float exrStoredValue(float v, bool asFloat);
 
 // Largest image readImageRgb accepts (width x height): 256 M pixels, e.g. a
 // 16384 x 8192 environment map is 128 M. Checked before any allocation.

@@ -61,6 +61,58 @@ std::vector<glm::dvec3> stitchedEstimate(ReferenceBaker& r, const Layout& layout
         out.push_back(glm::dvec3(pages.pages[ids[i].page].pixels[ids[i].index]));
     return out;
 }
+
+// The paths each texel of the reference gets: a pilot of options.pilotSpp
+// paths (stream `pilotSeed`) measures each texel's second moment m; a quarter
+// of the budget is shared evenly (a pilot can miss a texel's rare bright
+// paths), the rest as m^(2/3); the budget is in rays (paths longer than
+// kNominalRays, a high albedo's, get proportionally fewer), and the fallback's
+// where the pilot says the budget could not resolve twice the expected error.
+struct Budget {
+    std::vector<uint32_t> spp;  // per texel, in coveredTexels() order
+    int meanSpp = 0;
+};
+Budget shareBudget(ReferenceBaker& r, const ErrorCheckOptions& options, uint64_t pilotSeed) {
+    const size_t count = r.coveredTexels().size();
+    Budget b{std::vector<uint32_t>(count, uint32_t(options.pilotSpp)), 0};
+    const std::vector<glm::dvec4> pilot = r.sampleTexels(pilotSeed, b.spp);
+    const double n0 = options.pilotSpp;
+    std::vector<double> weight(count);
+    double weightSum = 0.0;
+    for (size_t i = 0; i < count; ++i) {
+        weight[i] = std::pow(pilot[i].w / n0, 2.0 / 3.0);
+        weightSum += weight[i];
+    }
+    const auto allocate = [&](int meanSpp) {
+        b.meanSpp = meanSpp;
+        const double floorSpp = std::max(2.0, 0.25 * meanSpp);
+        const double share = weightSum > 0.0 ? (double(meanSpp) - floorSpp) * double(count) / weightSum : 0.0;
+        for (size_t i = 0; i < count; ++i)
+            b.spp[i] = uint32_t(std::min(floorSpp + std::floor(share * weight[i]), double(1 << 24)));
+    };
+    const ReferenceStats& traced = r.stats();  // the pilot's paths alone
+    const double raysPerPath = traced.paths > 0 ? double(traced.rays + traced.shadowRays) / double(traced.paths) : 1.0;
+    const double rayShare = std::min(1.0, kNominalRays / std::max(raysPerPath, 1.0));
+    const auto scaled = [&](int paths) { return std::max(2, int(std::lround(paths * rayShare))); };
+    allocate(scaled(options.spp));
+    if (options.fallbackSpp > 0 && options.expectedError > 0.0) {
+        // the standard error of the mean product at this budget, from the pilot's sample variances (the
+        // reference's noise alone): past (2 expectedError)^2 / 3 not even twice the expected error would
+        // be conclusive, and the fallback's bound is worth as much
+        double squares = 0.0, sum = 0.0;
+        for (size_t i = 0; i < count; ++i) {
+            const double texelMean = (pilot[i].x + pilot[i].y + pilot[i].z) / (3.0 * n0);
+            const double s = std::max(0.0, (pilot[i].w - n0 * texelMean * texelMean) / (n0 - 1.0)) / double(b.spp[i]);
+            squares += s * s;
+            sum += texelMean;
+        }
+        const double mapMean = sum / double(count);
+        const double predicted = mapMean > 0.0 ? std::sqrt(squares) / double(count) / (mapMean * mapMean) : 0.0;
+        if (predicted > 4.0 * options.expectedError * options.expectedError / 3.0)
+            allocate(scaled(std::min(options.fallbackSpp, options.spp)));
+    }
+    return b;
+}
 }  // namespace
 
 void setAutoBudget(ErrorCheckOptions& options, int directions, double bakeEstimate) {
@@ -93,52 +145,9 @@ Expected<ErrorCheck> checkError(const Scene& scene, const Layout& layout, const 
     const int64_t count = int64_t(ids.size());
     if (count == 0) return Status::error("error check: no texel is covered in both the bake and the reference");
 
-    // pilot: each texel's samples' second moment sets its share of the budget
     const uint64_t seed = hash(ro.seed, 0xE220C4EC4ull);
-    std::vector<uint32_t> spp(ids.size(), uint32_t(options.pilotSpp));
-    const std::vector<glm::dvec4> pilot = r.sampleTexels(hash(seed, 0), spp);
-    std::vector<double> weight(ids.size(), 0.0);
-    double weightSum = 0.0;
-    const double n0 = options.pilotSpp;
-    for (size_t i = 0; i < ids.size(); ++i) {
-        weight[i] = std::pow(pilot[i].w / n0, 2.0 / 3.0);
-        weightSum += weight[i];
-    }
-    // a quarter of the budget evenly (a pilot can miss a texel's rare bright paths), the rest by weight
-    const auto allocate = [&](int meanSpp) {
-        const double budget = double(meanSpp) * double(count);
-        const double floorSpp = std::max(2.0, 0.25 * meanSpp);
-        const double share = weightSum > 0.0 ? (budget - floorSpp * double(count)) / weightSum : 0.0;
-        for (size_t i = 0; i < ids.size(); ++i)
-            spp[i] = uint32_t(std::min(floorSpp + std::floor(share * weight[i]), double(1 << 24)));
-    };
-    // the budget is in rays: paths longer than kNominalRays (a high albedo's) get proportionally fewer
-    const ReferenceStats& traced = r.stats();
-    const double raysPerPath = traced.paths > 0 ? double(traced.rays + traced.shadowRays) / double(traced.paths) : 1.0;
-    const double rayShare = std::min(1.0, kNominalRays / std::max(raysPerPath, 1.0));
-    const auto scaled = [&](int paths) { return std::max(2, int(std::lround(paths * rayShare))); };
-    int meanSpp = scaled(options.spp);
-    allocate(meanSpp);
-    if (options.fallbackSpp > 0 && options.expectedError > 0.0) {
-        // the standard error of the mean product at this budget, from the pilot's sample variances (the
-        // reference's noise alone): past (2 expectedError)^2 / 3 not even twice the expected error would
-        // be conclusive, and the fallback's bound is worth as much
-        double squares = 0.0, sum = 0.0;
-        for (size_t i = 0; i < ids.size(); ++i) {
-                const double texelMean = (pilot[i].x + pilot[i].y + pilot[i].z) / (3.0 * n0);
-            const double s = std::max(0.0, (pilot[i].w - n0 * texelMean * texelMean) / (n0 - 1.0)) / double(spp[i]);
-            squares += s * s;
-            sum += texelMean;
-        }
-        const double mapMean = sum / double(count);
-        const double predicted = mapMean > 0.0 ? std::sqrt(squares) / double(count) / (mapMean * mapMean) : 0.0;
-        const double resolvable = 4.0 * options.expectedError * options.expectedError / 3.0;
-        if (predicted > resolvable) {
-            meanSpp = scaled(std::min(options.fallbackSpp, options.spp));
-            allocate(meanSpp);
-        }
-    }
-
+    const Budget budget = shareBudget(r, options, hash(seed, 0));
+    const std::vector<uint32_t>& spp = budget.spp;
     const std::array<std::vector<glm::dvec3>, 2> estimates = {
         stitchedEstimate(r, layout, maps, ids, spp, hash(seed, 1), options.stitchSeams),
         stitchedEstimate(r, layout, maps, ids, spp, hash(seed, 2), options.stitchSeams)};
@@ -169,8 +178,8 @@ Expected<ErrorCheck> checkError(const Scene& scene, const Layout& layout, const 
     out.upperBound = std::sqrt(std::max(0.0, out.meanSquare + 2.0 * out.meanSquareError));
     out.texels = count;
     out.coveredTexels = covered;
-    out.spp = meanSpp;
-    for (size_t i = 0; i < ids.size(); ++i) out.paths += (options.pilotSpp + 2 * int64_t(spp[i]));
+    out.spp = budget.meanSpp;
+    for (uint32_t n : spp) out.paths += options.pilotSpp + 2 * int64_t(n);
     out.seconds = secondsSince(t0);
     return out;
 }

@@ -271,7 +271,7 @@ int runBake(const BakeArgs& args) {
         check.reference.threads = 0;
         check.stitchSeams = args.seams == "stitch";
         if (args.errorCheck == "auto")
-            setAutoBudget(check, (*baker)->progress().directionsDone, (*baker)->stats().errorEstimate());
+            setAutoBudget(check, (*baker)->progress().directionsDone, estimate);
         else
             check.spp = std::atoi(args.errorCheck.c_str());
         auto result = checkError(loaded->scene, loaded->layout, maps, check);

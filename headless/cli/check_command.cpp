@@ -31,9 +31,8 @@ nlohmann::json readStats(const std::string& bakeDir) {
     return nlohmann::json::parse(in, nullptr, false);
 }
 
-// What the flags left out as BAKE_DIR/stats.json "settings" (sky, env, seams) say.
-void settingsAsBaked(CheckArgs& args) {
-    const nlohmann::json stats = readStats(args.bakeDir);
+// What the flags left out as the bake's stats.json "settings" (sky, env, seams) say.
+void settingsAsBaked(const nlohmann::json& stats, CheckArgs& args) {
     const nlohmann::json s = stats.is_object() && stats.contains("settings") ? stats["settings"] : nlohmann::json::object();
     const auto take = [&s](const char* key, std::string& value) {
         if (value.empty() && s.contains(key) && s[key].is_string()) value = s[key].get<std::string>();
@@ -46,7 +45,8 @@ void settingsAsBaked(CheckArgs& args) {
 }
 
 int runCheck(CheckArgs args) {
-    settingsAsBaked(args);
+    const nlohmann::json stats = readStats(args.bakeDir);
+    settingsAsBaked(stats, args);
     ErrorCheckOptions options;
     auto sky = parseColor(args.sky.empty() ? "0,0,0" : args.sky, "--sky");
     if (!sky) return fail(sky.error());
@@ -55,7 +55,6 @@ int runCheck(CheckArgs args) {
     options.reference.threads = args.threads;
     options.reference.seed = args.seed;
     if (args.spp == "auto") {  // as the bake's own check: from its directions and its estimate
-        const nlohmann::json stats = readStats(args.bakeDir);
         const nlohmann::json* noise = stats.is_object() && stats.contains("noise") ? &stats["noise"] : nullptr;
         if (!noise || !stats.contains("directions") || !noise->contains("relative"))
             return fail(args.bakeDir + "/stats.json: no directions and noise estimate to take the budget from; give --spp N");
