@@ -217,12 +217,25 @@ struct Baker::Impl {
     }
     double rampLogWeight(int round) const { return rampLogWeight(round, historyPlateau); }
     // Rounds between radiance refreshes after round j: 1 while bounces are
-    // still needed (refreshEveryRound), then one more every 32 rounds, at most 8.
-    int refreshInterval(int round) const {
-        return std::clamp((round - std::max(0, refreshEveryRound - 64)) / 32, 1, 8);
+    // still needed (refreshEveryRound), then one more every 32 rounds, at most
+    // 8, and at most half the rounds the running mean remembers under a ramp
+    // ending at `plateau` (rampMemory): a steep ramp's mean is its last few
+    // rounds, which must read fresh radiance (design notes "Refreshes as
+    // often as the mean forgets").
+    int refreshInterval(int round, int plateau) const {
+        const int thinned = (round - std::max(0, refreshEveryRound - 64)) / 32;
+        return std::clamp(std::min(thinned, int(rampMemory(round, plateau) / 2.0)), 1, 8);
     }
     // Whether the outgoing radiance is refreshed after round j (finishRound, and bounceLag's model of it).
-    bool refreshesAfter(int round) const { return (round + 1) % refreshInterval(round) == 0 || round + 1 == rounds(); }
+    bool refreshesAfter(int round, int plateau) const {
+        return (round + 1) % refreshInterval(round, plateau) == 0 || round + 1 == rounds();
+    }
+    // The rounds' weights up to j over round j's, summed: min(j+1, plateau)^p
+    // integrates to plateau / (p + 1) over the ramp, then 1 a round.
+    double rampMemory(int round, int plateau) const {
+        const double ramp = std::min(round + 1, std::max(1, plateau));
+        return ramp / (historyPower + 1.0) + double(std::max(0, round + 1 - std::max(1, plateau)));
+    }
     void noteMemory();  // peaks into stats
     // The outgoing radiance the bundles read: meta.frag over every page, then the padding.
     void refreshRadiance(uint32_t key);  // key: the direction just done (random numbers)

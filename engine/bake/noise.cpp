@@ -99,7 +99,7 @@ void Baker::Impl::runLagModel(LagModel& m, int rounds, int plateau, double lambd
     const double missed = lagMissedShare();
     for (int j = m.rounds; j < rounds; ++j)
         m.advance(j > 0 ? std::exp(rampLogWeight(j - 1, plateau) - rampLogWeight(j, plateau)) : 1.0,
-                  refreshesAfter(j), lambda, missed);
+                  refreshesAfter(j, plateau), lambda, missed);
 }
 
 // The model advances from the rounds it has run (a resumed bake runs it from 0).

@@ -96,8 +96,9 @@ void Baker::Impl::finishRound(int round) {
     stats.directionsDone = std::min(options.directions, (round + 1) * shareCount());
     // Refresh the outgoing radiance the next bundles read. After every round
     // while each one adds a bounce the estimate needs; later every j/32 rounds
-    // (at most 8): the estimate then moves slowly and the refresh is a pass over every page.
-    if (refreshesAfter(round)) {
+    // (at most 8, and at most half the ramp's memory: refreshInterval):
+    // the estimate then moves slowly and the refresh is a pass over every page.
+    if (refreshesAfter(round, historyPlateau)) {
         auto tr = Clock::now();
         combineShares(round);
         stats.secondsCombine += secondsSince(tr);

@@ -184,12 +184,15 @@ inline std::string describe(const Summary& s, int resolution) {
 // refreshEveryRound): after direction k (0-based) the outgoing radiance the
 // next bundles read is refreshed after every direction until the bounces the
 // largest albedo rho needs (ln 1000 / (1 - rho), at least 64), then when
-// (k + 1) % clamp((k - shift) / 32, 1, 8) == 0, and after the last direction.
-// Mirrored here for furnaceExpectation(); if the engine's schedule changes,
-// update this (it moves the rho 0.9 expectations by ~0.1%).
-inline bool radianceRefreshedAfter(int k, int directions, double rho) {
+// (k + 1) % clamp(min((k - shift) / 32, memory / 2), 1, 8) == 0, memory the
+// ramp's (min(k + 1, plateau) / (power + 1) + max(0, k + 1 - plateau)), and
+// after the last direction. Mirrored here for furnaceExpectation(); if the
+// engine's schedule changes, update this (it moves the rho 0.9 expectations by ~0.1%).
+inline bool radianceRefreshedAfter(int k, int directions, double rho, double historyPower, int plateau) {
     const int everyDirection = std::max(64, int(std::ceil(std::log(1000.0) / (1.0 - std::min(rho, 0.99)))));
-    const int interval = std::clamp((k - std::max(0, everyDirection - 64)) / 32, 1, 8);
+    const int rampEnd = std::max(1, plateau);
+    const double memory = std::min(k + 1, rampEnd) / (historyPower + 1.0) + std::max(0, k + 1 - rampEnd);
+    const int interval = std::clamp(std::min((k - std::max(0, everyDirection - 64)) / 32, int(memory / 2.0)), 1, 8);
     return (k + 1) % interval == 0 || k + 1 == directions;
 }
 
@@ -210,7 +213,7 @@ inline double furnaceExpectation(double le, double rho, int directions, double h
         sum += w * (le + rho * r);
         weights += w;
         m = weights > 0 ? sum / weights : le + rho * r;  // early weights can underflow to 0
-        if (radianceRefreshedAfter(k, directions, rho)) r = m;
+        if (radianceRefreshedAfter(k, directions, rho, historyPower, plateau)) r = m;
     }
     return m;
 }
