@@ -66,8 +66,12 @@ std::vector<glm::dvec3> stitchedEstimate(ReferenceBaker& r, const Layout& layout
 // paths (stream `pilotSeed`) measures each texel's second moment m; a quarter
 // of the budget is shared evenly (a pilot can miss a texel's rare bright
 // paths), the rest as m^(2/3); the budget is in rays (paths longer than
-// kNominalRays, a high albedo's, get proportionally fewer), and the fallback's
-// where the pilot says the budget could not resolve twice the expected error.
+// kNominalRays, a high albedo's, get proportionally fewer). Where the pilot
+// says the budget could not resolve the expected error, more paths, up to
+// options.maxSpp, if those would resolve twice it; else the fallback's, where
+// not even twice it could be. The counts follow from the pilot (a third
+// stream) and the bake's own figures alone: stopping when A and B agreed
+// would bias the estimate.
 struct Budget {
     std::vector<uint32_t> spp;  // per texel, in coveredTexels() order
     int meanSpp = 0;
@@ -95,10 +99,9 @@ Budget shareBudget(ReferenceBaker& r, const ErrorCheckOptions& options, uint64_t
     const double rayShare = std::min(1.0, kNominalRays / std::max(raysPerPath, 1.0));
     const auto scaled = [&](int paths) { return std::max(2, int(std::lround(paths * rayShare))); };
     allocate(scaled(options.spp));
-    if (options.fallbackSpp > 0 && options.expectedError > 0.0) {
+    if (options.expectedError > 0.0 && (options.fallbackSpp > 0 || options.maxSpp > options.spp)) {
         // the standard error of the mean product at this budget, from the pilot's sample variances (the
-        // reference's noise alone): past (2 expectedError)^2 / 3 not even twice the expected error would
-        // be conclusive, and the fallback's bound is worth as much
+        // reference's noise alone); it falls as 1 / the paths
         double squares = 0.0, sum = 0.0;
         for (size_t i = 0; i < count; ++i) {
             const double texelMean = (pilot[i].x + pilot[i].y + pilot[i].z) / (3.0 * n0);
@@ -108,7 +111,14 @@ Budget shareBudget(ReferenceBaker& r, const ErrorCheckOptions& options, uint64_t
         }
         const double mapMean = sum / double(count);
         const double predicted = mapMean > 0.0 ? std::sqrt(squares) / double(count) / (mapMean * mapMean) : 0.0;
-        if (predicted > 4.0 * options.expectedError * options.expectedError / 3.0)
+        const auto predictedAt = [&](int meanSpp) { return predicted * double(b.meanSpp) / double(meanSpp); };
+        // the standard error at which an error the size of the expected one would be conclusive
+        const double resolves = options.expectedError * options.expectedError / 3.0;
+        const int most = scaled(std::max(options.maxSpp, options.spp));
+        if (predicted <= resolves) return b;
+        if (most > b.meanSpp && predictedAt(most) <= 4.0 * resolves)  // more paths, up to the most, would tell
+            allocate(std::min(most, int(std::ceil(double(b.meanSpp) * predicted / resolves))));
+        else if (options.fallbackSpp > 0 && predicted > 4.0 * resolves)  // not even twice the expected error
             allocate(scaled(std::min(options.fallbackSpp, options.spp)));
     }
     return b;
@@ -117,6 +127,7 @@ Budget shareBudget(ReferenceBaker& r, const ErrorCheckOptions& options, uint64_t
 
 void setAutoBudget(ErrorCheckOptions& options, int directions, double bakeEstimate) {
     options.spp = std::clamp(directions / 4, 16, 1024);
+    options.maxSpp = std::clamp(directions, 16, 4096);
     options.fallbackSpp = std::clamp(directions / 16, 16, 256);
     options.expectedError = bakeEstimate;
 }
