@@ -67,8 +67,8 @@ std::vector<glm::dvec3> stitchedEstimate(ReferenceBaker& r, const Layout& layout
 // of the budget is shared evenly (a pilot can miss a texel's rare bright
 // paths), the rest as m^(2/3); the budget is in rays (paths longer than
 // kNominalRays, a high albedo's, get proportionally fewer). Where the pilot
-// says the budget could not resolve 1.5 times the expected error, more paths,
-// up to options.maxSpp, if those would resolve twice it; else the fallback's,
+// says the budget could not resolve the expected error, more paths, up to
+// options.maxSpp, if those would resolve twice it; else the fallback's,
 // where not even twice it could be. The counts follow from the pilot (a third
 // stream) and the bake's own figures alone: stopping when A and B agreed
 // would bias the estimate.
@@ -112,9 +112,8 @@ Budget shareBudget(ReferenceBaker& r, const ErrorCheckOptions& options, uint64_t
         const double mapMean = sum / double(count);
         const double predicted = mapMean > 0.0 ? std::sqrt(squares) / double(count) / (mapMean * mapMean) : 0.0;
         const auto predictedAt = [&](int meanSpp) { return predicted * double(b.meanSpp) / double(meanSpp); };
-        // the standard error at which an error 1.5 times the expected one would be conclusive: more
-        // would find an estimate short by less than that, at up to 2.25 times the paths
-        const double resolves = 2.25 * options.expectedError * options.expectedError / 3.0;
+        // the standard error at which an error the size of the expected one would be conclusive
+        const double resolves = options.expectedError * options.expectedError / 3.0;
         const int most = scaled(std::max(options.maxSpp, options.spp));
         if (predicted <= resolves) return b;
         const double twice = 4.0 * options.expectedError * options.expectedError / 3.0;
@@ -129,7 +128,7 @@ Budget shareBudget(ReferenceBaker& r, const ErrorCheckOptions& options, uint64_t
 
 void setAutoBudget(ErrorCheckOptions& options, int directions, double bakeEstimate) {
     options.spp = std::clamp(directions / 4, 16, 1024);
-    options.maxSpp = std::clamp(directions, 16, 4096);
+    options.maxSpp = std::clamp(directions / 2, 16, 2048);
     options.fallbackSpp = std::clamp(directions / 16, 16, 256);
     options.expectedError = bakeEstimate;
 }

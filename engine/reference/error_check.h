@@ -49,9 +49,9 @@ struct ErrorCheckOptions {
     // fewer (segments and shadow rays; 1.7-5.7 on the bench's scenes); where the pilot's paths take
     // more (a high albedo: the rho 0.99 furnace's run ~100 bounces), proportionally fewer.
     int spp = 256;
-    // Where the pilot's variances say that spp would not resolve 1.5 x expectedError (> 0: the error
-    // the bake expects, e.g. its noise estimate), more paths up to maxSpp where those would resolve
-    // twice it (the bake's estimate may miss a bias, the check's reason to be); where not even twice it
+    // Where the pilot's variances say that spp would not resolve expectedError (> 0: the error the
+    // bake expects, e.g. its noise estimate), more paths up to maxSpp where those would resolve twice
+    // it (the bake's estimate may miss a bias, the check's reason to be); where not even twice it
     // could be resolved at spp, fallbackSpp (> 0) instead: small maps spread the reference's noise
     // over few texels, and there the check can only bound the error cheaply.
     int maxSpp = 0;
@@ -85,8 +85,8 @@ struct ErrorCheck {
 // The budget `bake --error-check auto` and `check --spp auto` take after a
 // bake of `directions` whose own estimate (noise and resolution probe) was
 // `bakeEstimate`: directions / 4 paths per texel and estimate (16 to 1024);
-// up to directions (4096) where that would not resolve 1.5 times the
-// estimate but those would resolve twice it; directions / 16 (16 to 256) where not even twice it
+// up to directions / 2 (2048) where that would not resolve the estimate but
+// those would resolve twice it; directions / 16 (16 to 256) where not even twice it
 // could be resolved.
 void setAutoBudget(ErrorCheckOptions& options, int directions, double bakeEstimate);
 

@@ -99,8 +99,8 @@ void addBakeOptions(CLI::App& cmd, BakeArgs& a) {
                    "After the bake, estimate its error against the truth with the CPU path tracer: two independent "
                    "estimates of every texel of N paths each on average, where the reference is noisiest most "
                    "(stats.json noise.check; unbiased, bias and noise alike); auto = directions / 4 (16 to 1024), up "
-                   "to directions (4096) where that could not resolve 1.5 times the bake's own estimate but those "
-                   "could twice it, directions / 16 where not even twice it could be; off")
+                   "to directions / 2 (2048) where that could not resolve the bake's own estimate but those could "
+                   "twice it, directions / 16 where not even twice it could be; off")
         ->check(countOr({"auto", "off"}, 1 << 20))
         ->capture_default_str();
     addSeamsOption(cmd, a.seams);

@@ -111,9 +111,9 @@ TEST(ErrorCheck, ExactMapsReadZeroAndInconclusive) {
 // The budget: where the pilot says 256 paths could not resolve twice the
 // expected error (0.01 %: far under the reference's noise over ~800 texels),
 // the fallback's; where they could (5 %), all of them; where they could not
-// resolve 1.5 times it but 4096 could resolve twice it, about as many as
-// resolve 1.5 times it (the standard error falls as 1 / the paths: twice
-// 256's where 1.5 times the error squared is 1.5 of 256 paths' standard error).
+// resolve it but 4096 could resolve twice it, about as many as resolve it
+// (the standard error falls as 1 / the paths: twice 256's to resolve an
+// error whose square is 1.5 of 256 paths' standard error).
 TEST(ErrorCheck, FallsBackWhereTheExpectedErrorCannotBeResolved) {
     Furnace f = furnace();
     ErrorCheckOptions o;
@@ -123,7 +123,7 @@ TEST(ErrorCheck, FallsBackWhereTheExpectedErrorCannotBeResolved) {
     EXPECT_EQ(check(f, f.truth, o).spp, 16);
     o.expectedError = 0.05;
     EXPECT_EQ(check(f, f.truth, o).spp, 256);
-    o.expectedError = std::sqrt(1.5 * check(f, f.truth).meanSquareError) / 1.5;
+    o.expectedError = std::sqrt(1.5 * check(f, f.truth).meanSquareError);
     const int spp = check(f, f.truth, o).spp;
     EXPECT_GT(spp, 256 * 3 / 2);
     EXPECT_LT(spp, 256 * 3);
