@@ -119,10 +119,10 @@ std::string coverageFileName(int page) {
 double exrRoundingError(const LightmapPages& maps) {
     double squares = 0.0, sum = 0.0;
     int64_t n = 0;
-    for (size_t p = 0; p < maps.pages.size(); ++p) {
+    for (size_t p = 0; p < std::min(maps.pages.size(), maps.covered.size()); ++p) {
         const bool asFloat = io::exrWritesFloat(maps.pages[p]);
         for (size_t t = 0; t < maps.pages[p].pixels.size(); ++t) {
-            if (p >= maps.covered.size() || !maps.covered[p][t]) continue;
+            if (!maps.covered[p][t]) continue;
             for (int c = 0; c < 3; ++c) {
                 const float v = maps.pages[p].pixels[t][c];
                 const double d = double(io::exrStoredValue(v, asFloat)) - double(v);

@@ -233,8 +233,8 @@ struct Baker::Impl {
     // The rounds' weights up to j over round j's, summed: min(j+1, plateau)^p
     // integrates to plateau / (p + 1) over the ramp, then 1 a round.
     double rampMemory(int round, int plateau) const {
-        const double ramp = std::min(round + 1, std::max(1, plateau));
-        return ramp / (historyPower + 1.0) + double(std::max(0, round + 1 - std::max(1, plateau)));
+        const int rampEnd = std::max(1, plateau);
+        return std::min(round + 1, rampEnd) / (historyPower + 1.0) + std::max(0, round + 1 - rampEnd);
     }
     void noteMemory();  // peaks into stats
     // The outgoing radiance the bundles read: meta.frag over every page, then the padding.

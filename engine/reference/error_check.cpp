@@ -111,13 +111,11 @@ Budget shareBudget(ReferenceBaker& r, const ErrorCheckOptions& options, uint64_t
         }
         const double mapMean = sum / double(count);
         const double predicted = mapMean > 0.0 ? std::sqrt(squares) / double(count) / (mapMean * mapMean) : 0.0;
-        const auto predictedAt = [&](int meanSpp) { return predicted * double(b.meanSpp) / double(meanSpp); };
-        // the standard error at which an error the size of the expected one would be conclusive
-        const double resolves = options.expectedError * options.expectedError / 3.0;
-        const int most = scaled(std::max(options.maxSpp, options.spp));
+        // the standard error at which an error the size of the expected one (or twice it) would be conclusive
+        const double resolves = options.expectedError * options.expectedError / 3.0, twice = 4.0 * resolves;
         if (predicted <= resolves) return b;
-        const double twice = 4.0 * options.expectedError * options.expectedError / 3.0;
-        if (most > b.meanSpp && predictedAt(most) <= twice)  // more paths, up to the most, would tell
+        const int most = scaled(std::max(options.maxSpp, options.spp));
+        if (most > b.meanSpp && predicted * b.meanSpp / most <= twice)  // more paths, up to the most, would tell
             allocate(std::min(most, int(std::ceil(double(b.meanSpp) * predicted / resolves))));
         else if (options.fallbackSpp > 0 && predicted > twice)  // not even twice the expected error
             allocate(scaled(std::min(options.fallbackSpp, options.spp)));
