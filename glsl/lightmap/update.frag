@@ -205,8 +205,9 @@ void foldTexel(ivec3 texel, vec3 incoming, float w, uint h, bool flat_, vec2 poi
 
 // The texel's own surface at this sample (main): the sample's point, its
 // depth along d, the triangle's plane (normal ng, ng . d = cg), the texel's
-// size, the surface's curvature, the node flag of the side it looks to and
-// where the plane is exact (the fragment's point; the curved texels' sample's).
+// size, the surface's curvature, the node flag of the side it looks to,
+// where the plane is exact (the fragment's point; the curved texels' sample's)
+// and the triangle's chart borders (TexelSample's).
 struct OwnSurface {
     vec3 position;
     vec3 anchor;
@@ -216,6 +217,9 @@ struct OwnSurface {
     float texelSize;
     float curvature;
     uint side;
+    uint borders;
+    vec3 bary;
+    mat3 baryGradient;
 };
 
 const float NO_CROSSING = 3.0e38;
@@ -232,6 +236,23 @@ const float NO_CROSSING = 3.0e38;
 float ownCrossing(OwnSurface own, ivec2 pixel, vec2 offset) {
     float planeDepth = own.depth + dot(vec2(dot(own.ng, bundleU), dot(own.ng, bundleV)), offset) / own.cg;
     vec3 crossing = own.position - bundleU * offset.x - bundleV * offset.y + bundleDir * (planeDepth - own.depth);
+    // At or past a chart border of the triangle the surface ends, and the
+    // ray passes beside it, outside whatever it closes. A node there at the
+    // plane's depth is its triangle's all the same: the bundle pass covers a
+    // pixel where the triangle snapped to the raster's subpixel grid does and
+    // keeps the true plane for depth, so a wall nearly edge-on to d has nodes
+    // millimetres past its edge; and a ray through the edge itself meets the
+    // wall on it at the crossing's own depth. A closed box's texels there saw
+    // the sky and the sun from inside (tests/golden/closed_box_bake_test.cpp:
+    // 9 of 2400 texels lit at 1024 directions, up to 0.55 % of the sun's E / pi).
+    // So no crossing within four depth margins of a border edge or past it,
+    // beside the edge (not past its ends, where the chart may go on round a
+    // corner the edge's line cuts: ExactFootprintBake's L-shaped ledge).
+    vec3 b = own.bary + (crossing - own.position) * own.baryGradient;
+    for (int k = 0; k < 3; ++k)
+        if ((own.borders & (1u << k)) != 0u && b[k] < 4.0 * depthBias * length(own.baryGradient[k]) &&
+            b[(k + 1) % 3] >= 0.0 && b[(k + 2) % 3] >= 0.0)
+            return NO_CROSSING;
     // one texel: two bundle pixels where the pixel is half a texel (the
     // uniform grid's rule), this texel's own size where the leaf's pixel is
     // finer (adaptive leaves take their pixel from their densest texel)
@@ -392,6 +413,11 @@ struct TexelSample {
     float weight;
     vec2 point;  // the point, texels from the texel's centre along the page's axes
     bool flat_;  // point holds it (a curved texel's samples keep no moments)
+    // the triangle's barycentrics at `position` and their gradients along its
+    // plane (columns, per scene unit): where a ray crosses the plane relative
+    // to the triangle's chart borders (ownCrossing); borders 0 on curved texels
+    vec3 bary;
+    mat3 baryGradient;
 };
 
 // One sample of a texel along its triangle's plane (frame f at the texel's
@@ -415,10 +441,15 @@ bool planeSample(FlatFrame f, ivec3 texel, vec3 leafPoint, out TexelSample s) {
         // none found: the footprint's point, read along its pixel's ray up to
         // half a pixel beside it, spread over the texel less that so that the
         // two stay in it (a pixel wider than the texel: the pixel's jitter
-        // alone spreads the samples)
+        // alone spreads the samples). Not where that leaves the chart: a
+        // partial texel's centre lies off it, and a point drawn toward it
+        // past the chart's edge read the sun from outside what the edge
+        // closes (a closed box's ceiling, 7 mm past its wall: 0.06 % of the
+        // sun's light in its corner texels).
         jitter = footprintOffset(f.bary, f.baryDx, f.baryDy, f.flags, onChart, footprintSample);
         float facing = length(faceNormal) > 0.0 ? abs(dot(normalize(faceNormal), bundleDir)) : 1.0;
-        jitter *= clamp(1.0 - pixelSize / (max(facing, 1e-3) * max(s.texelSize, 1e-30)), 0.0, 1.0);
+        vec2 drawn = jitter * clamp(1.0 - pixelSize / (max(facing, 1e-3) * max(s.texelSize, 1e-30)), 0.0, 1.0);
+        if (!offFootprint(drawn, f.bary, f.baryDx, f.baryDy, f.flags, onChart)) jitter = drawn;
     }
 #else
     // the leaf of the texel's centre takes its sample (a sample whose point
@@ -443,6 +474,13 @@ bool planeSample(FlatFrame f, ivec3 texel, vec3 leafPoint, out TexelSample s) {
     for (int k = 0; k < 3; ++k)
         if (baryStep[k] < 0.0) inside = min(inside, max(f.bary[k], 0.0) / -baryStep[k]);
     s.n = normalize(f.normal + (f.normalDx * jitter.x + f.normalDy * jitter.y) * inside);
+    s.bary = f.bary + baryStep;
+    // texel steps from a step v along the plane: (ax . v, ay . v) = (J^T J)^-1 J^T v, J = (positionDx, positionDy)
+    mat2 metric = inverse(mat2(dot(f.positionDx, f.positionDx), dot(f.positionDx, f.positionDy),
+                               dot(f.positionDx, f.positionDy), dot(f.positionDy, f.positionDy)));
+    vec3 ax = metric[0][0] * f.positionDx + metric[1][0] * f.positionDy;
+    vec3 ay = metric[0][1] * f.positionDx + metric[1][1] * f.positionDy;
+    for (int k = 0; k < 3; ++k) s.baryGradient[k] = f.baryDx[k] * ax + f.baryDy[k] * ay;
     // the triangle's plane, on the side the bundle pass gives its fragments
     // (lib/triangle_side.glsl; the flag is computed with the mesh)
     s.ng = s.n;
@@ -494,6 +532,8 @@ bool curvedSample(out TexelSample s) {
     s.weight = 1.0;
     s.point = vec2(0.0);
     s.flat_ = false;
+    s.bary = vec3(0.0);
+    s.baryGradient = mat3(0.0);
     return true;
 }
 #else
@@ -565,7 +605,9 @@ void main() {
     float cg = dot(s.ng, bundleDir);
     if (abs(cg) < 1e-4) return;
     vec2 offset = (g - floor(g) - 0.5) * pixelSize;  // texel minus pixel centre, scene units
-    OwnSurface own = OwnSurface(s.position, s.anchor, b.z, s.ng, cg, s.texelSize, s.curvature, ownSide);
+    uint borders = s.flat_ ? (s.flags / TRIANGLE_CHART_BORDER0) & 7u : 0u;
+    OwnSurface own = OwnSurface(s.position, s.anchor, b.z, s.ng, cg, s.texelSize, s.curvature, ownSide, borders,
+                                s.bary, s.baryGradient);
     float self = ownCrossing(own, pixel, offset);
     if (self == NO_CROSSING) {
         // the three on the point's side of the pixel's centre (toward sign(offset)): their rays pass nearer it
