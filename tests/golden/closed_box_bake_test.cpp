@@ -18,6 +18,7 @@
 // over its texels at 256-2048 directions.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 
 #include "support/bake_helper.h"
