@@ -117,6 +117,16 @@ vec3 curvedTriangleNormal(CurvedTriangle c, vec2 p) {
     return c.normal.xyz + c.normalDx.xyz * q.x + c.normalDy.xyz * q.y;
 }
 
+// Whether the surface at p bends toward the side its face normal looks to (a
+// tube's inside, a bowl's): the shading normal's turn along each texel axis
+// against that axis's step, summed (the shape operator's trace, up to scale),
+// is negative where the normals converge ahead of the surface.
+bool curvedTriangleConcave(CurvedTriangle c, vec2 p) {
+    float bend = dot(c.normalDx.xyz, c.positionDx.xyz) / max(dot(c.positionDx.xyz, c.positionDx.xyz), 1e-30) +
+                 dot(c.normalDy.xyz, c.positionDy.xyz) / max(dot(c.positionDy.xyz, c.positionDy.xyz), 1e-30);
+    return bend * dot(curvedTriangleNormal(c, p), c.faceNormal.xyz) < 0.0;
+}
+
 // Curved texel `index`'s centre on its owner triangle (the first of its
 // triangles, which holds the centre, or of a partial texel the point nearest
 // it): where the leaf that takes its samples is.

@@ -413,6 +413,7 @@ struct TexelSample {
     float weight;
     vec2 point;  // the point, texels from the texel's centre along the page's axes
     bool flat_;  // point holds it (a curved texel's samples keep no moments)
+    bool concave;  // a curved texel's surface bends toward ng's side (curvedTriangleConcave)
     // the triangle's barycentrics at `position` and their gradients along its
     // plane (columns, per scene unit): where a ray crosses the plane relative
     // to the triangle's chart borders (ownCrossing); borders 0 on curved texels
@@ -465,6 +466,7 @@ bool planeSample(FlatFrame f, ivec3 texel, vec3 leafPoint, out TexelSample s) {
     s.position = f.position + f.positionDx * jitter.x + f.positionDy * jitter.y;
     s.point = jitter;
     s.flat_ = true;
+    s.concave = false;
     s.anchor = leafPoint;
     // the shading normal where the point leaves the triangle, not extrapolated
     // past it: a triangle far smaller than a texel (300 to a texel on the
@@ -532,6 +534,7 @@ bool curvedSample(out TexelSample s) {
     s.weight = 1.0;
     s.point = vec2(0.0);
     s.flat_ = false;
+    s.concave = curvedTriangleConcave(tri, point);
     s.bary = vec3(0.0);
     s.baryGradient = mat3(0.0);
     return true;
@@ -628,7 +631,16 @@ void main() {
         // update pass's samples weigh by their cosine, and are skipped: a
         // ray beside the point from its own depth starts inside a convex
         // surface and sees its back (a sphere in the furnace 1.3 % dark).
-        if (self == NO_CROSSING && curved) self = b.z;
+        // Where the surface bends toward the sun (a tube's inside), that ray
+        // starts behind the surface as it rises beside the point, or passes
+        // outside it altogether where the sun grazes it: a closed cylinder's
+        // inside read the sun along its silhouette (123 of 1366 texels lit
+        // at 256 directions, up to 2 % of the sun's E / pi). There the surface
+        // itself shades the point: a dark sample.
+        if (self == NO_CROSSING && curved) {
+            self = b.z;
+            lit = lit && !s.concave;
+        }
 #endif
         if (self == NO_CROSSING) return;
     }
