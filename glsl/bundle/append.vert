@@ -27,6 +27,8 @@ flat out uint vTriangle;
 flat out vec3 vUv0XPlane;
 flat out vec3 vUv0YPlane;
 flat out uint vMaterial;
+// the true triangle: each corner's leaf grid x, y and depth (append.frag planePoint)
+flat out vec3 vCorners[3];
 
 vec3 plane(vec2 p0, vec2 p1, vec2 p2, float a0, float a1, float a2, float det) {
     vec2 e1 = p1 - p0, e2 = p2 - p0;
@@ -54,6 +56,7 @@ void main() {
     for (int k = 0; k < 3; ++k) {
         c[k] = bundleFromWorld(vertices[v0 + uint(k)].position.xyz);
         p[k] = gridFromRoot(rootFromBundle(c[k].xy));  // the true plane, not the snapped one: exact depths
+        vCorners[k] = vec3(p[k], c[k].z);
     }
     float det = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[2].x - p[0].x) * (p[1].y - p[0].y);
     if (det != 0.0) {

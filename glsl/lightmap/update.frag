@@ -140,13 +140,16 @@ vec3 environment(vec3 dir) {
 }
 
 // Of two nodes at the same depth, whether node i is preferred to node j:
-// seen from the looking side (a double-sided surface's two nodes share a
-// depth), then the brighter (so any order of the list picks the same node).
+// seen from the looking side, then the brighter (so any order of the list
+// picks the same node). A double-sided surface's two nodes share a depth, and
+// so do two faces where a ray passes their shared edge (append.frag
+// planePoint): a box's near and far sides along its outline, where the ray
+// touches the box from outside. The far side's back is black, and taken (the
+// first in the list, at equal radiance) it was 1.7e-6 of the rho 0.99
+// furnace's samples (each 1e-6 of black reads costs it 0.01 %).
 bool preferred(uint i, uint j, uint seen) {
-#ifdef BACK_SIDES
     bool visible = (nodes[i].depth & seen) != 0u, otherVisible = (nodes[j].depth & seen) != 0u;
     if (visible != otherVisible) return visible;
-#endif
     return nodes[i].radiance > nodes[j].radiance;
 }
 
