@@ -166,14 +166,14 @@ TEST(CurvedFootprintBake, TubeUnderAnOverheadSunReadsItsTurnsMean) {
 
 // The same sun pass on the tube's inside (its normals and winding turned in).
 // A sun across the tube (no component along x, so none through its open
-// ends) reaches nothing inside: every texel 0, exactly. The sun reaches a
-// texel's sample that finds no crossing of its facet along its pixel's ray
-// (a grazing facet, or facets finer than the pixel) along that ray from the
-// sample's own depth, which on a concave surface starts behind the surface
-// as it rises beside the point, or passes outside the tube where the sun
-// grazes it: before such samples were taken as shaded by the surface itself,
-// a closed cylinder (the same, with caps, turned about a skew axis) read 123
-// of 1366 texels lit at 256 directions, up to 2 % of the sun's E / pi.
+// ends) reaches nothing inside: every texel 0, exactly. A sample that finds
+// no crossing of its facet on its pixel's ray (a grazing facet, or facets
+// finer than the pixel) reads the sun along that ray from its own depth. On
+// a concave surface that ray starts behind the surface, which rises beside
+// the point, or passes outside the tube where the sun grazes it. Before such
+// samples counted as shaded by the surface, a closed cylinder (the same, with
+// caps, turned about a skew axis) read 123 of 1366 texels lit at 256
+// directions, up to 2 % of the sun's E / pi.
 // Then the lower half alone, a trough open to an overhead sun: every point
 // sees the sun, L_lm = E (-cos a) / pi at angle a from the top, mean
 // 2 E / pi^2 over the half turn; the samples the surface shades itself lie
