@@ -147,9 +147,8 @@ void checkScene(const char* file, const std::vector<glm::vec3>& directions, bool
         };
         // Every node of a pixel whose count differs lies on a triangle that
         // holds the centre or passes within the margin of it, at its depth
-        // there: the raster covers the triangle snapped to its subpixel grid,
-        // and a node read off the true one took its plane's depth off the face
-        // (a face nearly edge-on to d: metres, at a slope of 1000).
+        // there (the raster covers the triangle snapped to its subpixel grid:
+        // such a pixel's nodes are not compared one to one below).
         size_t strayNodes = 0;
         std::string firstStray;
         const size_t pixels = size_t(cap.width) * cap.height;
