@@ -10,6 +10,7 @@
 // holds it: its position, shading normal and plane are that triangle's.
 //
 // Needs shared/bundle_layout.h, lib/rounding.glsl and lib/texel_footprint.glsl.
+#include "lib/triangle_2d.glsl"
 
 // A curved texel: uvec4(x | y << 16, page, first ref, ref count | CURVED_TEXEL_FLAT | CURVED_TEXEL_EXACT).
 layout(std430, binding = BINDING_CURVED_TEXELS) readonly buffer CurvedTexels { uvec4 curvedTexels[]; };
@@ -37,14 +38,7 @@ struct CurvedTriangle {
 layout(std430, binding = BINDING_CURVED_TRIANGLES) readonly buffer CurvedTriangles { CurvedTriangle curvedTriangles[]; };
 
 // Whether page point p lies on triangle c (its edges count).
-bool curvedTriangleHolds(CurvedTriangle c, vec2 p) {
-    vec2 a = c.corners01.xy, b = c.corners01.zw, d = c.corner2.xy;
-    float area = (b.x - a.x) * (d.y - a.y) - (b.y - a.y) * (d.x - a.x);
-    vec3 w = vec3((d.x - b.x) * (p.y - b.y) - (d.y - b.y) * (p.x - b.x),
-                  (a.x - d.x) * (p.y - d.y) - (a.y - d.y) * (p.x - d.x),
-                  (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x));
-    return all(greaterThanEqual(w * sign(area), vec3(0.0)));
-}
+bool curvedTriangleHolds(CurvedTriangle c, vec2 p) { return triangleHolds(c.corners01.xy, c.corners01.zw, c.corner2.xy, p); }
 
 // A curved draw (lightmap/curved.vert) covers curved texels [curvedFirst,
 // curvedFirst + curvedCount) with one rectangle, curvedRowWidth texels a row
@@ -88,22 +82,8 @@ void useFootprintOf(uint index) {
 // A curved texel's square's centre in page texels (`head`: its first uvec4).
 vec2 curvedTexelSquareCentre(uvec4 head) { return vec2(curvedTexelTexel(head).xy) + 0.5; }
 
-// The point of segment [a, b] nearest p.
-vec2 nearestOnSegment(vec2 a, vec2 b, vec2 p) {
-    vec2 e = b - a;
-    return a + e * clamp(dot(p - a, e) / max(dot(e, e), 1e-30), 0.0, 1.0);
-}
-
 // The point of triangle c nearest page point p (p where c holds it).
-vec2 nearestOnTriangle(CurvedTriangle c, vec2 p) {
-    if (curvedTriangleHolds(c, p)) return p;
-    vec2 a = c.corners01.xy, b = c.corners01.zw, d = c.corner2.xy;
-    vec2 best = nearestOnSegment(a, b, p);
-    vec2 other = nearestOnSegment(b, d, p);
-    if (distance(other, p) < distance(best, p)) best = other;
-    other = nearestOnSegment(d, a, p);
-    return distance(other, p) < distance(best, p) ? other : best;
-}
+vec2 nearestOnTriangle(CurvedTriangle c, vec2 p) { return nearestOnTriangle(c.corners01.xy, c.corners01.zw, c.corner2.xy, p); }
 
 // Triangle c's position at page point p (its plane, extended past it).
 vec3 curvedTrianglePosition(CurvedTriangle c, vec2 p) {

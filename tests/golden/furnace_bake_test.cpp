@@ -110,14 +110,15 @@ TEST(FurnaceBake, Rho099Gives100Everywhere) {
 
 // ... and at 4096 directions, where the lag is gone, within 0.03 %: at rho
 // 0.99 each 1e-6 of samples that read black costs the map 0.01 %, and it
-// shows what the bundle lists lose. It read -0.086 % while a node of a
-// face nearly edge-on to d took its plane's depth off the face (the raster
-// covers the snapped triangle; append.frag planePoint) and a ray through the
-// inner box's outline took its far side's back at the near side's depth
-// (update.frag preferred): 4.3e-6 of the samples read black (2.1e-6 with
-// the depth on the face, 0.36e-6 with both). Seed 1 reads 99.9136 (-0.086 %)
-// before both, 99.9977 (-0.002 %) since (at 1024 directions, above, 98.41
-// before).
+// shows what the bundle lists lose. It read -0.086 % while a ray just
+// outside the inner box's outline met its far side's back before its near
+// side: the raster covers the snapped triangles, and their planes, read past
+// the outline where they cross, had swapped their order. append.frag now
+// reads them on the triangle's edge, where the two share a depth, and a tie
+// goes to the side the ray sees (update.frag preferred). Black reads: 4.3e-6
+// of the samples before, 2.1e-6 with the reads on the edge, 0.36e-6 with
+// both. Seed 1 reads 99.9136 (-0.086 %) before both, 99.9977 (-0.002 %)
+// since (at 1024 directions, above, 98.41 before).
 TEST(FurnaceBake, Rho099At4096DirectionsLosesNoSamples) {
     runFurnace({"assets/furnace/furnace_rho09.gltf", 0.99, 4096, 0.04, BakeOptions::Tiling::Adaptive, 0.0003, 0.99f, 1, true});
 }
