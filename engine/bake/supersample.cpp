@@ -1,5 +1,7 @@
 #include "bake/supersample.h"
 
+#include <algorithm>
+
 #include "core/check.h"
 #include "core/parallel.h"
 
@@ -21,9 +23,11 @@ Layout supersampledLayout(const Layout& layout, int k) {
 }
 
 int autoSupersample(const BakeMesh& mesh, const std::vector<uint32_t>& charts, const Layout& layout, int64_t memoryBudget) {
-    constexpr int64_t kMaxStateBytesPerTexel = 46;  // light-map state with double-sided materials
+    const bool backSides = std::any_of(mesh.triangles.begin(), mesh.triangles.end(),
+                                       [](const BakeTriangle& t) { return (t.flags & TRIANGLE_DOUBLE_SIDED) != 0u; });
+    const int64_t bytesPerTexel = lightmapStateBytesPerTexel(backSides);
     auto fits = [&](int k) {
-        return int64_t(layout.texelCount()) * k * k * kMaxStateBytesPerTexel <= memoryBudget / 2 &&
+        return int64_t(layout.texelCount()) * k * k * bytesPerTexel <= memoryBudget / 2 &&
                int64_t(layout.resolution) * k <= 16384;
     };
     if (!fits(2)) return 1;

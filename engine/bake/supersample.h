@@ -42,8 +42,16 @@ namespace bb {
 // and rectangles times k; the page UVs (rectangles' scale and offset) stay.
 Layout supersampledLayout(const Layout& layout, int k);
 
-// BakeOptions::supersample auto: the k whose light-map state (46 bytes a
-// texel at most) fits half the memory budget, 4 only where a fifth or more of
+// The light-map state's bytes a baked texel (Baker::Impl::init allocates
+// them; the CLI bake test checks 65): 28 a page (direct light 8, footprint
+// 16, owner's chart 2, dilation 1, same-chart neighbours 1) and 37 a layer
+// (accumulator 8, radiance 4, read modes 1, moments 16, slopes 8), which a
+// scene with double-sided triangles has twice (its back sides'). The curved
+// texels' records come on top (a few percent of the texels).
+constexpr int64_t lightmapStateBytesPerTexel(bool backSides) { return 28 + 37 * (backSides ? 2 : 1); }
+
+// BakeOptions::supersample auto: the k whose light-map state
+// (lightmapStateBytesPerTexel) fits half the memory budget, 4 only where a fifth or more of
 // the half-size texels are partial (a chart's edge cuts them off their
 // centre) or shared with another chart; else 2 (and 1 where neither fits).
 // Why (docs/design-notes.md "Quarter-size texels"): at 2 x 2 the bias of

@@ -23,6 +23,7 @@
 
 #include <cstdio>
 
+#include "bake/supersample.h"
 #include "support/bake_helper.h"
 #include "support/hand_scenes.h"
 
@@ -75,6 +76,9 @@ void checkPanelUnderCeiling(BakeOptions::DirectLight direct) {
     EXPECT_NEAR(middle / expected, 1.0, 0.02)
         << "the panel's back does not return the ceiling's light (one L_lm for both sides reads 1.0)";
     EXPECT_LT(front, 1e-3) << "the panel's front sees an empty world";
+    // the back sides' layers, as autoSupersample counts them (102 bytes a texel, not 65)
+    EXPECT_EQ(stats.lightmapStateBytes - stats.curvedTexelBytes,
+              int64_t(layout->resolution) * layout->resolution * layout->pageCount * lightmapStateBytesPerTexel(true));
 }
 
 TEST(DoubleSidedBake, PanelUnderCeilingTradesLightWithItsBackBundled) {

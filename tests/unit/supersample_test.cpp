@@ -179,7 +179,8 @@ TEST(Supersample, AQuarterSizeBakeWeighsTheWholeFootprintWhereAStripTookAHalfSiz
 }
 
 // auto: 4 where a fifth of the half-size texels are cut by a chart's edge or
-// shared, 2 on wide charts, each only where its state fits half the budget.
+// shared, 2 on wide charts, each only where its state fits half the budget
+// (65 bytes a baked texel, 102 with double-sided triangles' back sides).
 TEST(Supersample, AutoBakesQuarterSizeTexelsWhereChartsAreNarrowerThanTexels) {
     Layout layout;
     layout.resolution = 16;
@@ -190,11 +191,17 @@ TEST(Supersample, AutoBakesQuarterSizeTexelsWhereChartsAreNarrowerThanTexels) {
     BakeMesh strips;  // strips 0.3 texel tall off the half-size texels' centres: each one cuts the two it lies in
     for (int j = 0; j < 14; ++j) addPageQuad(strips, {1.0f, 1.275f + float(j)}, {15.0f, 1.575f + float(j)}, 16.0f);
     strips.pageFirstTriangle = {0, uint32_t(strips.triangles.size())};
-    const int64_t budget = 1 << 20;  // 16 x 256 texels x 46 bytes = 188 KB: fits half
+    const int64_t budget = 1 << 20;  // 16 x 256 texels x 65 bytes = 266 KB: fits half
     EXPECT_EQ(autoSupersample(wide, findLightmapCharts(wide), layout, budget), 2);
     EXPECT_EQ(autoSupersample(strips, findLightmapCharts(strips), layout, budget), 4);
-    EXPECT_EQ(autoSupersample(strips, findLightmapCharts(strips), layout, 200 << 10), 2) << "16x the state does not fit";
-    EXPECT_EQ(autoSupersample(strips, findLightmapCharts(strips), layout, 40 << 10), 1) << "nor 4x";
+    EXPECT_EQ(autoSupersample(strips, findLightmapCharts(strips), layout, 300 << 10), 2) << "16x the state does not fit";
+    EXPECT_EQ(autoSupersample(strips, findLightmapCharts(strips), layout, 60 << 10), 1) << "nor 4x";
+    // double-sided: 16 x 256 x 102 = 418 KB does not fit half of 600 KB, 266 KB would
+    BakeMesh twoSided = strips;
+    for (BakeTriangle& t : twoSided.triangles) t.flags |= TRIANGLE_DOUBLE_SIDED;
+    EXPECT_EQ(autoSupersample(strips, findLightmapCharts(strips), layout, 600 << 10), 4);
+    EXPECT_EQ(autoSupersample(twoSided, findLightmapCharts(twoSided), layout, 600 << 10), 2)
+        << "the back sides' layers count";
 }
 
 }  // namespace
