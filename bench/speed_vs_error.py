@@ -540,7 +540,7 @@ def write_outputs(name, cfg, rows, ref_note, ref_seconds, measured=None):
              "Measured %s. Scene `%s`, flags `%s`; converged reference: %s%s." %
              (measured or datetime.datetime.now().strftime("%Y-%m-%d %H:%M"), cfg["path"], " ".join(cfg["flags"]), ref_note,
               (", %.1f s" % ref_seconds) if ref_seconds else ""),
-             "bundlebake: defaults (bundle resolution from the texel density, 512M budget, stochastic rounding, "
+             "bundlebake: defaults (bundle resolution from the texel density, 4G memory budget, stochastic rounding, "
              "automatic history power, supersample auto), seed %s. Reference sweep: 2 threads, seed %s, flags `%s`." %
              (SWEEP_SEED, SWEEP_SEED, " ".join(cfg["reference_flags"]) or "(defaults: emitter sampling on)"), ""]
     rechecked = os.path.join(outdir, "rechecked.txt")
