@@ -30,9 +30,10 @@ import numpy as np
 
 from texel_classes import load
 
-# the floor's light-map position (64² asset layout) of a floor point (x, z) in metres
-def floor_texel(x, z):
-    return 22.77 + z * 34.72, 1.12 + (0.553 - x) * 34.70
+# the floor's chart in the 64² asset layout: texel u = 22.77 + 34.72 z, v = 1.12 + 34.70 (0.553 - x), metres
+def floor_point(u_texels, v_texels):
+    """The floor point (x, z) at light-map position (u, v) in texels."""
+    return 0.553 - (v_texels - 1.12) / 34.70, (u_texels - 22.77) / 34.72
 
 
 TALL_BLOCK = np.array([(0.423, 0.247), (0.265, 0.296), (0.314, 0.456), (0.472, 0.406)])
@@ -90,8 +91,7 @@ def main():
     fine = light.shape[0]
     ys, xs = np.mgrid[0:fine, 0:fine]
     u, v = (xs + 0.5) / fine, (ys + 0.5) / fine
-    z = (u * 64 - 22.77) / 34.72
-    x = 0.553 - (v * 64 - 1.12) / 34.70
+    x, z = floor_point(u * 64, v * 64)
     centre = TALL_BLOCK.mean(axis=0)
     under = np.ones(light.shape, bool)
     for i in range(4):

@@ -597,9 +597,7 @@ Status Baker::Impl::init(const Scene& scene) {
     if (layout.resolution > maxTex)
         return Status::error("--resolution " + std::to_string(layout.resolution) + " exceeds GL_MAX_TEXTURE_SIZE " +
                              std::to_string(maxTex));
-    if (std::any_of(mesh.triangles.begin(), mesh.triangles.end(),
-                    [](const BakeTriangle& t) { return (t.flags & TRIANGLE_DOUBLE_SIDED) != 0u; }))
-        backLayerOffset = layout.pageCount;
+    if (hasBackSides(mesh)) backLayerOffset = layout.pageCount;
     if (stateLayers() > maxLayers)
         return Status::error(std::to_string(layout.pageCount) + " light map pages" +
                              (backLayerOffset ? " (twice over: double-sided materials)" : "") +

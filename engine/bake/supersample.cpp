@@ -22,10 +22,13 @@ Layout supersampledLayout(const Layout& layout, int k) {
     return out;
 }
 
+bool hasBackSides(const BakeMesh& mesh) {
+    return std::any_of(mesh.triangles.begin(), mesh.triangles.end(),
+                       [](const BakeTriangle& t) { return (t.flags & TRIANGLE_DOUBLE_SIDED) != 0u; });
+}
+
 int autoSupersample(const BakeMesh& mesh, const std::vector<uint32_t>& charts, const Layout& layout, int64_t memoryBudget) {
-    const bool backSides = std::any_of(mesh.triangles.begin(), mesh.triangles.end(),
-                                       [](const BakeTriangle& t) { return (t.flags & TRIANGLE_DOUBLE_SIDED) != 0u; });
-    const int64_t bytesPerTexel = lightmapStateBytesPerTexel(backSides);
+    const int64_t bytesPerTexel = lightmapStateBytesPerTexel(hasBackSides(mesh));
     auto fits = [&](int k) {
         return int64_t(layout.texelCount()) * k * k * bytesPerTexel <= memoryBudget / 2 &&
                int64_t(layout.resolution) * k <= 16384;

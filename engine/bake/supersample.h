@@ -50,6 +50,9 @@ Layout supersampledLayout(const Layout& layout, int k);
 // texels' records come on top (a few percent of the texels).
 constexpr int64_t lightmapStateBytesPerTexel(bool backSides) { return 28 + 37 * (backSides ? 2 : 1); }
 
+// Whether the state has back sides' layers: any triangle is double-sided.
+bool hasBackSides(const BakeMesh& mesh);
+
 // BakeOptions::supersample auto: the k whose light-map state
 // (lightmapStateBytesPerTexel) fits half the memory budget, 4 only where a fifth or more of
 // the half-size texels are partial (a chart's edge cuts them off their

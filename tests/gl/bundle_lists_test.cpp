@@ -16,8 +16,8 @@
 //   - sorted depths within 1e-4 x the scene size + 1e-3 x tan(theta) x pixel
 //     size (near an edge, + 1/512 x tan(theta) x pixel size: a centre the
 //     snapped triangle covers and the true one does not reads the depth of
-//     the true one's nearest point), theta the angle between the
-//     triangle's normal and d (the stored
+//     the true one's nearest point), theta the angle between the triangle's
+//     normal and d (the stored
 //     depth loses its 2 low mantissa bits to the flags, a relative 5e-7, and
 //     llvmpipe interpolates in float: a position error e across the plane is a
 //     depth error tan(theta) e, which matters on nearly edge-on triangles;
@@ -138,10 +138,13 @@ void checkScene(const char* file, const std::vector<glm::vec3>& directions, bool
         // (near an edge, plus half a subpixel step along the slope: the raster
         // covers the snapped triangle, and a centre off the true one reads its
         // depth at the triangle's nearest point, append.frag planePoint)
-        auto allowedDepthError = [&](int t, bool nearAnEdge) {
+        auto facingOf = [&](int t) {  // triangle t's normal . d
             glm::dvec3 a(mesh.vertices[3 * size_t(t)].position), b(mesh.vertices[3 * size_t(t) + 1].position),
                 c(mesh.vertices[3 * size_t(t) + 2].position);
-            const double facing = glm::dot(glm::normalize(glm::cross(b - a, c - a)), glm::dvec3(cap.dir));
+            return glm::dot(glm::normalize(glm::cross(b - a, c - a)), glm::dvec3(cap.dir));
+        };
+        auto allowedDepthError = [&](int t, bool nearAnEdge) {
+            const double facing = facingOf(t);
             const double tanTheta = std::sqrt(std::max(0.0, 1.0 - facing * facing)) / std::max(std::abs(facing), 1e-9);
             return 1e-4 * sceneSize + (1e-3 + (nearAnEdge ? 1.0 / 512.0 : 0.0)) * tanTheta * cap.pixelSize;
         };
@@ -182,9 +185,7 @@ void checkScene(const char* file, const std::vector<glm::vec3>& directions, bool
             for (size_t k = 0; k < hits.size(); ++k) {
                 ++compared;
                 const int t = hits[k].triangle;
-                glm::dvec3 a(mesh.vertices[3 * size_t(t)].position), b(mesh.vertices[3 * size_t(t) + 1].position),
-                    c(mesh.vertices[3 * size_t(t) + 2].position);
-                const double facing = glm::dot(glm::normalize(glm::cross(b - a, c - a)), glm::dvec3(cap.dir));
+                const double facing = facingOf(t);
                 const double error = std::abs(double(gpuDepths[k]) - hits[k].depth);
                 const double allowedError = allowedDepthError(t, cpu.nearEdge[i]);
                 maxDepthError = std::max(maxDepthError, error);
