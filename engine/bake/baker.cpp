@@ -796,13 +796,16 @@ Status Baker::Impl::init(const Scene& scene) {
     const int64_t fixedBytes = MemoryTracker::gpu().current() - gpuAtStart;
     stats.memoryBudget = options.memoryBudget;
     int64_t bundleBytes = options.bundleMemory > 0 ? options.bundleMemory : options.memoryBudget - fixedBytes;
+    // the direct light's passes run first, in the bundle pass's share
     constexpr int64_t kMinBundleBytes = 64 * 64 * 4 + 1024 * 12;
-    if (bundleBytes < kMinBundleBytes) {
+    const int64_t directBytes = directLightPeakBytes();
+    if (bundleBytes < std::max(kMinBundleBytes, directBytes)) {
         auto mib = [](int64_t b) { return std::to_string((b + (1 << 20) - 1) >> 20) + " MiB"; };
         return Status::error("--memory-budget " + mib(options.memoryBudget) + " is too small: the light maps take " +
                              mib(stats.lightmapStateBytes) + ", the mesh and materials " +
-                             mib(fixedBytes - stats.lightmapStateBytes) + "; give at least " +
-                             mib(fixedBytes + (16 << 20)));
+                             mib(fixedBytes - stats.lightmapStateBytes) +
+                             (directBytes ? ", the direct light's passes " + mib(directBytes) : std::string()) +
+                             "; give at least " + mib(fixedBytes + std::max<int64_t>(16 << 20, directBytes)));
     }
     maxTileSize = std::min({maxTex, maxViewport, 2048});
     while (maxTileSize > 64 && int64_t(maxTileSize) * maxTileSize * 4 > bundleBytes / 4) maxTileSize /= 2;
@@ -899,7 +902,14 @@ Expected<std::unique_ptr<Baker>> Baker::create(const Scene& scene, const Layout&
     int& k = impl->options.supersample;
     if (k == 0) {
         const BakeMesh mesh = buildBakeMesh(scene, layout);
-        k = autoSupersample(mesh, findLightmapCharts(mesh), layout, options.memoryBudget);
+        // a distance cube, if any light takes one, at its largest (its size follows the bundle pixels)
+        const bool emitters = std::any_of(mesh.triangles.begin(), mesh.triangles.end(),
+                                          [](const BakeTriangle& t) { return (t.flags & TRIANGLE_EMISSIVE) != 0u; });
+        const bool cubes = !scene.punctualLights.empty() ||
+                           (emitters && options.directLight != BakeOptions::DirectLight::Bundles);
+        const int face = options.emitterShadowSize > 0 ? options.emitterShadowSize : kMaxShadowCubeSize;
+        k = autoSupersample(mesh, findLightmapCharts(mesh), layout,
+                            options.memoryBudget - (cubes ? distanceCubeBytes(face) : 0));
     }
     impl->stats.supersample = k;
     impl->outputLayout = layout;

@@ -28,6 +28,12 @@ void chartNeighbourBits(const std::vector<uint8_t>& codes, const std::vector<int
 // One page's texelCharts codes: each texel's owner's chart, TEXEL_CHART_MASK where none owns it (baker.cpp).
 void ownerChartCodes(const std::vector<int32_t>& owner, const std::vector<uint32_t>& chart, std::vector<uint16_t>& codes);
 
+// The direct light's distance cubes (direct_light.cpp): a face at most
+// kMaxShadowCubeSize texels a side, two 32-bit words a texel of its six
+// faces and a 32-bit depth face.
+constexpr int kMaxShadowCubeSize = 512;
+constexpr int64_t distanceCubeBytes(int faceSize) { return int64_t(faceSize) * faceSize * (6 * 8 + 4); }
+
 struct Baker::Impl {
     BakeOptions options;
     BakeMesh mesh;
@@ -187,6 +193,7 @@ struct Baker::Impl {
     bool useExplicitEmitters() const;
     int emitterSamples() const;  // options.emitterSamples, or its automatic count
     void bakeEmitters();
+    int64_t directLightPeakBytes() const;  // the emitters' and punctual lights' passes' GL memory
     void uploadAlphaMasks(const Scene& scene);      // cutouts.cpp: the tables, bound at their SSBO bindings
     void bindAlphaMasks() const;
     void bakePunctualLights();    // point and spot lights into the direct sums (direct_light.cpp)

@@ -269,8 +269,25 @@ int Baker::Impl::emitterSamples() const {
 namespace {
 int shadowCubeSize(const Baker::Impl& m) {
     const int size = m.options.emitterShadowSize;
-    return size > 0 ? size : std::clamp(4 * m.gridSize / m.options.supersample, 64, 512);
+    return size > 0 ? size : std::clamp(4 * m.gridSize / m.options.supersample, 64, kMaxShadowCubeSize);
 }
+}  // namespace
+
+// What the emitters' and the point and spot lights' passes hold at their
+// peak, beyond the light maps: a distance cube, the emitters' float sums, and the
+// noise estimate's share (DirectHalves). The budget's check holds it to the
+// budget (Baker::Impl::init): the direct light runs before the bundle pass's
+// buffers are made, in their share.
+int64_t Baker::Impl::directLightPeakBytes() const {
+    if (!useExplicitEmitters() && punctualLights.empty()) return 0;
+    const int64_t pages = layout.pageCount, res = layout.resolution;
+    const int64_t sampled = halfWidth / options.supersample;
+    const int64_t halves = int64_t(halfWidth) * halfWidth * pages * 16 + sampled * sampled * pages * 4;
+    const int64_t sums = useExplicitEmitters() ? res * res * pages * 16 : 0;
+    return distanceCubeBytes(shadowCubeSize(*this)) + sums + halves;
+}
+
+namespace {
 
 // One light's (an emitter sample's, a point or spot light's) irradiance times
 // the visibility `cube` holds, into the direct light's float sums: `program`

@@ -113,6 +113,37 @@ TEST(CliBakeErrors, MemoryBudgetTooSmallForTheLightMaps) {
     EXPECT_LE(stats["memory"]["peak_gpu_bytes"].get<double>(), 32.0 * (1 << 20));
 }
 
+// The emitters' passes hold a distance cube (8 MiB for this box at 128²) and
+// float sums besides the light maps, before the bundle pass's buffers are
+// made: the budget's check counts them. A budget too small says so (it used
+// to bake the Cornell box at 4 MiB with 8 MiB of GL memory); the budget the
+// error asks for bakes within itself, supersampling left to auto.
+TEST(CliBakeErrors, MemoryBudgetHoldsTheDirectLightsPasses) {
+    TempDir tmp("budget_direct");
+    ASSERT_TRUE(tmp.ok());
+    const std::vector<std::string> bake = {"bake", sourcePath("assets/cornell_box/cornell_box.gltf"), "--backend",
+                                           "osmesa", "--resolution", "128", "--directions", "2", "--no-progress",
+                                           "--no-preview"};
+    auto with = [&](std::vector<std::string> args, const std::string& out, const std::string& budget) {
+        args.insert(args.end(), {"-o", out, "--memory-budget", budget});
+        return args;
+    };
+    CliResult r = runCli(with(bake, tmp / "small", "4M"), tmp);
+    expectOneErrorLine(r, "--memory-budget");
+    EXPECT_NE(r.err.find("the direct light's passes"), std::string::npos) << r.err;
+    EXPECT_EQ(filesIn(tmp.path() / "small"), 0u);
+    const size_t at = r.err.find("give at least ");
+    ASSERT_NE(at, std::string::npos) << r.err;
+    const int mib = std::stoi(r.err.substr(at + 14));
+    EXPECT_GT(mib, 4);
+    CliResult ok = runCli(with(bake, tmp / "fits", std::to_string(mib) + "M"), tmp);
+    ASSERT_EQ(ok.exitCode, 0) << ok.err;
+    nlohmann::json stats = nlohmann::json::parse(readFileBytes(tmp / "fits/stats.json"), nullptr, false);
+    ASSERT_FALSE(stats.is_discarded());
+    EXPECT_GT(stats["memory"]["by_category"]["direct light"]["peak_bytes"].get<double>(), 4.0 * (1 << 20));
+    EXPECT_LE(stats["memory"]["peak_gpu_bytes"].get<double>(), double(mib) * (1 << 20));
+}
+
 TEST(CliBake, SuccessWritesCompleteOutputsAndNoTempFiles) {
     TempDir tmp("success");
     ASSERT_TRUE(tmp.ok());
