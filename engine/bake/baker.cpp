@@ -796,10 +796,10 @@ Status Baker::Impl::init(const Scene& scene) {
     const int64_t fixedBytes = MemoryTracker::gpu().current() - gpuAtStart;
     stats.memoryBudget = options.memoryBudget;
     int64_t bundleBytes = options.bundleMemory > 0 ? options.bundleMemory : options.memoryBudget - fixedBytes;
-    // the direct light's passes run first, in the bundle pass's share
+    // the direct light's passes run first, in what the bundle pass's buffers will take
     constexpr int64_t kMinBundleBytes = 64 * 64 * 4 + 1024 * 12;
     const int64_t directBytes = directLightPeakBytes();
-    if (bundleBytes < std::max(kMinBundleBytes, directBytes)) {
+    if (bundleBytes < kMinBundleBytes || options.memoryBudget - fixedBytes < directBytes) {
         auto mib = [](int64_t b) { return std::to_string((b + (1 << 20) - 1) >> 20) + " MiB"; };
         return Status::error("--memory-budget " + mib(options.memoryBudget) + " is too small: the light maps take " +
                              mib(stats.lightmapStateBytes) + ", the mesh and materials " +
