@@ -90,6 +90,12 @@ TEST(CliBakeErrors, UnwritableOutputDir) {
     EXPECT_EQ(readFileBytes(file), "x");
 }
 
+// `args` writing to `out` under a memory budget
+std::vector<std::string> withBudget(std::vector<std::string> args, const std::string& out, const std::string& budget) {
+    args.insert(args.end(), {"-o", out, "--memory-budget", budget});
+    return args;
+}
+
 // A budget that cannot hold the light maps: one error line naming the sizes
 // and the flag, no outputs; the same bake fits a budget just above its need.
 TEST(CliBakeErrors, MemoryBudgetTooSmallForTheLightMaps) {
@@ -98,15 +104,11 @@ TEST(CliBakeErrors, MemoryBudgetTooSmallForTheLightMaps) {
     // 512^2 page texels x 65 bytes = 16.25 MiB of light-map state (the error rounds it up)
     const std::vector<std::string> bake = {"bake", furnace(), "--backend", "osmesa", "--uv-layout", "asset",
                                            "--resolution", "512", "--directions", "2", "--no-progress", "--no-preview"};
-    auto with = [&](std::vector<std::string> args, const std::string& out, const std::string& budget) {
-        args.insert(args.end(), {"-o", out, "--memory-budget", budget});
-        return args;
-    };
-    CliResult r = runCli(with(bake, tmp / "small", "4M"), tmp);
+    CliResult r = runCli(withBudget(bake, tmp / "small", "4M"), tmp);
     expectOneErrorLine(r, "--memory-budget");
     EXPECT_NE(r.err.find("light maps take 17 MiB"), std::string::npos) << r.err;
     EXPECT_EQ(filesIn(tmp.path() / "small"), 0u) << "nothing may be written when the bake does not fit";
-    CliResult ok = runCli(with(bake, tmp / "fits", "32M"), tmp);
+    CliResult ok = runCli(withBudget(bake, tmp / "fits", "32M"), tmp);
     EXPECT_EQ(ok.exitCode, 0) << ok.err;
     nlohmann::json stats = nlohmann::json::parse(readFileBytes(tmp / "fits/stats.json"), nullptr, false);
     ASSERT_FALSE(stats.is_discarded());
@@ -124,11 +126,7 @@ TEST(CliBakeErrors, MemoryBudgetHoldsTheDirectLightsPasses) {
     const std::vector<std::string> bake = {"bake", sourcePath("assets/cornell_box/cornell_box.gltf"), "--backend",
                                            "osmesa", "--resolution", "128", "--directions", "2", "--no-progress",
                                            "--no-preview"};
-    auto with = [&](std::vector<std::string> args, const std::string& out, const std::string& budget) {
-        args.insert(args.end(), {"-o", out, "--memory-budget", budget});
-        return args;
-    };
-    CliResult r = runCli(with(bake, tmp / "small", "4M"), tmp);
+    CliResult r = runCli(withBudget(bake, tmp / "small", "4M"), tmp);
     expectOneErrorLine(r, "--memory-budget");
     EXPECT_NE(r.err.find("the direct light's passes"), std::string::npos) << r.err;
     EXPECT_EQ(filesIn(tmp.path() / "small"), 0u);
@@ -136,7 +134,7 @@ TEST(CliBakeErrors, MemoryBudgetHoldsTheDirectLightsPasses) {
     ASSERT_NE(at, std::string::npos) << r.err;
     const int mib = std::stoi(r.err.substr(at + 14));
     EXPECT_GT(mib, 4);
-    CliResult ok = runCli(with(bake, tmp / "fits", std::to_string(mib) + "M"), tmp);
+    CliResult ok = runCli(withBudget(bake, tmp / "fits", std::to_string(mib) + "M"), tmp);
     ASSERT_EQ(ok.exitCode, 0) << ok.err;
     nlohmann::json stats = nlohmann::json::parse(readFileBytes(tmp / "fits/stats.json"), nullptr, false);
     ASSERT_FALSE(stats.is_discarded());
