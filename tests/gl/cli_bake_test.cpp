@@ -117,8 +117,8 @@ TEST(CliBakeErrors, MemoryBudgetTooSmallForTheLightMaps) {
 
 // The emitters' passes hold a distance cube (8 MiB for this box at 128²) and
 // float sums besides the light maps, before the bundle pass's buffers are
-// made: the budget's check counts them. A budget too small says so (it used
-// to bake the Cornell box at 4 MiB with 8 MiB of GL memory); the budget the
+// made: the budget's check counts them. A budget too small says so (the old
+// check let this bake run at 4 MiB, over its budget); the budget the
 // error asks for bakes within itself, supersampling left to auto.
 TEST(CliBakeErrors, MemoryBudgetHoldsTheDirectLightsPasses) {
     TempDir tmp("budget_direct");
