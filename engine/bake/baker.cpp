@@ -795,11 +795,12 @@ Status Baker::Impl::init(const Scene& scene) {
     // is one SSBO binding.
     const int64_t fixedBytes = MemoryTracker::gpu().current() - gpuAtStart;
     stats.memoryBudget = options.memoryBudget;
-    int64_t bundleBytes = options.bundleMemory > 0 ? options.bundleMemory : options.memoryBudget - fixedBytes;
+    const int64_t leftBytes = options.memoryBudget - fixedBytes;
+    int64_t bundleBytes = options.bundleMemory > 0 ? options.bundleMemory : leftBytes;
     // the direct light's passes run first, in what the bundle pass's buffers will take
     constexpr int64_t kMinBundleBytes = 64 * 64 * 4 + 1024 * 12;
     const int64_t directBytes = directLightPeakBytes();
-    if (bundleBytes < kMinBundleBytes || options.memoryBudget - fixedBytes < directBytes) {
+    if (bundleBytes < kMinBundleBytes || leftBytes < directBytes) {
         auto mib = [](int64_t b) { return std::to_string((b + (1 << 20) - 1) >> 20) + " MiB"; };
         return Status::error("--memory-budget " + mib(options.memoryBudget) + " is too small: the light maps take " +
                              mib(stats.lightmapStateBytes) + ", the mesh and materials " +
@@ -902,14 +903,8 @@ Expected<std::unique_ptr<Baker>> Baker::create(const Scene& scene, const Layout&
     int& k = impl->options.supersample;
     if (k == 0) {
         const BakeMesh mesh = buildBakeMesh(scene, layout);
-        // a distance cube, if any light takes one, at its largest (its size follows the bundle pixels)
-        const bool emitters = std::any_of(mesh.triangles.begin(), mesh.triangles.end(),
-                                          [](const BakeTriangle& t) { return (t.flags & TRIANGLE_EMISSIVE) != 0u; });
-        const bool cubes = !scene.punctualLights.empty() ||
-                           (emitters && options.directLight != BakeOptions::DirectLight::Bundles);
-        const int face = options.emitterShadowSize > 0 ? options.emitterShadowSize : kMaxShadowCubeSize;
         k = autoSupersample(mesh, findLightmapCharts(mesh), layout,
-                            options.memoryBudget - (cubes ? distanceCubeBytes(face) : 0));
+                            options.memoryBudget - largestDistanceCubeBytes(scene, mesh, options));
     }
     impl->stats.supersample = k;
     impl->outputLayout = layout;

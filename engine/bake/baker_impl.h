@@ -28,11 +28,10 @@ void chartNeighbourBits(const std::vector<uint8_t>& codes, const std::vector<int
 // One page's texelCharts codes: each texel's owner's chart, TEXEL_CHART_MASK where none owns it (baker.cpp).
 void ownerChartCodes(const std::vector<int32_t>& owner, const std::vector<uint32_t>& chart, std::vector<uint16_t>& codes);
 
-// The direct light's distance cubes (direct_light.cpp): a face at most
-// kMaxShadowCubeSize texels a side, two 32-bit words a texel of its six
-// faces and a 32-bit depth face.
-constexpr int kMaxShadowCubeSize = 512;
-constexpr int64_t distanceCubeBytes(int faceSize) { return int64_t(faceSize) * faceSize * (6 * 8 + 4); }
+// The direct light's distance cube at its largest, where any light may take
+// one (direct_light.cpp): before the bake's pixels, and so the cube's size,
+// are known (supersample auto).
+int64_t largestDistanceCubeBytes(const Scene& scene, const BakeMesh& mesh, const BakeOptions& options);
 
 struct Baker::Impl {
     BakeOptions options;

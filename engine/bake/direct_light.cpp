@@ -267,6 +267,11 @@ int Baker::Impl::emitterSamples() const {
 // emitters took 2.4 s of a 2.8 s bake at 16 directions): they stay at the
 // layout's texels' size, where they measured as good as the finer ones.
 namespace {
+constexpr int kMaxShadowCubeSize = 512;
+
+// a cube's GL memory: two 32-bit words a texel of its six faces and a 32-bit depth face
+constexpr int64_t distanceCubeBytes(int faceSize) { return int64_t(faceSize) * faceSize * (6 * 8 + 4); }
+
 int shadowCubeSize(const Baker::Impl& m) {
     const int size = m.options.emitterShadowSize;
     return size > 0 ? size : std::clamp(4 * m.gridSize / m.options.supersample, 64, kMaxShadowCubeSize);
@@ -275,9 +280,9 @@ int shadowCubeSize(const Baker::Impl& m) {
 
 // What the emitters' and the point and spot lights' passes hold at their
 // peak, beyond the light maps: a distance cube, the emitters' float sums, and the
-// noise estimate's share (DirectHalves). The budget's check holds it to the
-// budget (Baker::Impl::init): the direct light runs before the bundle pass's
-// buffers are made, in their share.
+// noise estimate's share (DirectHalves). The budget's check holds it to what
+// the budget leaves (Baker::Impl::init): the direct light runs before the
+// bundle pass's buffers are made.
 int64_t Baker::Impl::directLightPeakBytes() const {
     if (!useExplicitEmitters() && punctualLights.empty()) return 0;
     const int64_t pages = layout.pageCount, res = layout.resolution;
@@ -285,6 +290,12 @@ int64_t Baker::Impl::directLightPeakBytes() const {
     const int64_t halves = int64_t(halfWidth) * halfWidth * pages * 16 + sampled * sampled * pages * 4;
     const int64_t sums = useExplicitEmitters() ? res * res * pages * 16 : 0;
     return distanceCubeBytes(shadowCubeSize(*this)) + sums + halves;
+}
+
+int64_t largestDistanceCubeBytes(const Scene& scene, const BakeMesh& mesh, const BakeOptions& options) {
+    const bool emitters = options.directLight != BakeOptions::DirectLight::Bundles && mesh.anyTriangle(TRIANGLE_EMISSIVE);
+    if (!emitters && scene.punctualLights.empty()) return 0;
+    return distanceCubeBytes(options.emitterShadowSize > 0 ? options.emitterShadowSize : kMaxShadowCubeSize);
 }
 
 namespace {

@@ -1,7 +1,5 @@
 #include "bake/supersample.h"
 
-#include <algorithm>
-
 #include "core/check.h"
 #include "core/parallel.h"
 
@@ -20,11 +18,6 @@ Layout supersampledLayout(const Layout& layout, int k) {
         r.texelDensity *= float(k);
     }
     return out;
-}
-
-bool hasBackSides(const BakeMesh& mesh) {
-    return std::any_of(mesh.triangles.begin(), mesh.triangles.end(),
-                       [](const BakeTriangle& t) { return (t.flags & TRIANGLE_DOUBLE_SIDED) != 0u; });
 }
 
 int autoSupersample(const BakeMesh& mesh, const std::vector<uint32_t>& charts, const Layout& layout, int64_t memoryBudget) {

@@ -51,7 +51,7 @@ Layout supersampledLayout(const Layout& layout, int k);
 constexpr int64_t lightmapStateBytesPerTexel(bool backSides) { return 28 + 37 * (backSides ? 2 : 1); }
 
 // Whether the state has back sides' layers: any triangle is double-sided.
-bool hasBackSides(const BakeMesh& mesh);
+inline bool hasBackSides(const BakeMesh& mesh) { return mesh.anyTriangle(TRIANGLE_DOUBLE_SIDED); }
 
 // BakeOptions::supersample auto: the k whose light-map state
 // (lightmapStateBytesPerTexel) fits half the memory budget, 4 only where a fifth or more of

@@ -7,6 +7,7 @@
 // as-is into a vertex buffer.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -48,6 +49,10 @@ struct BakeMesh {
     Bounds bounds;            // of the positions (local space)
     glm::dvec3 origin{0.0};   // Scene::origin: world = position + origin (directions are the same in both)
     size_t triangleCount() const { return triangles.size(); }
+    // whether any triangle has any of `flags` (TRIANGLE_*)
+    bool anyTriangle(uint32_t flags) const {
+        return std::any_of(triangles.begin(), triangles.end(), [&](const BakeTriangle& t) { return (t.flags & flags) != 0u; });
+    }
 };
 
 // Transforms every instance into local space in double (the exact world
